@@ -1,0 +1,1 @@
+"""Built-in backends (filled in as the feature lands)."""

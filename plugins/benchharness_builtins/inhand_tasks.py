@@ -1,0 +1,1 @@
+"""Built-in inhand_tasks (filled in as the feature lands)."""

@@ -1,0 +1,1 @@
+"""Built-in robots (filled in as the feature lands)."""

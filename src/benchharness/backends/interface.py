@@ -1,0 +1,368 @@
+"""The Backend interface: everything above ``backends/`` talks to physics through it.
+
+Only modules in ``benchharness.backends`` import ``pybullet`` or ``sapien``.
+Robots, sensors, strategies and the cube mechanism use this interface alone,
+so each of them runs on every backend, and a new engine is added by one
+class that passes ``tests/backends/test_conformance.py``.
+
+Conventions (see :mod:`benchharness.geometry`): SI units; poses are
+:class:`~benchharness.geometry.Pose` with scalar-last quaternions; joint
+vectors follow :meth:`Backend.joint_names` order (movable joints only); a
+body is an integer handle; a link is named by its URDF name, ``None`` for a
+body's base.
+
+Contact normals point from body B towards body A (the direction of the force
+that B exerts on A), so for a box A resting on ground B the normal is +z and
+the normal force is about the box's weight.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import ClassVar, Sequence
+
+import numpy as np
+
+from ..geometry import Pose
+
+__all__ = [
+    "Backend",
+    "BackendError",
+    "BodyId",
+    "Box",
+    "CameraSpec",
+    "Capabilities",
+    "CapabilityError",
+    "Contact",
+    "Cylinder",
+    "JointInfo",
+    "JointState",
+    "MeshShape",
+    "PhysicsConfig",
+    "RayHits",
+    "Shape",
+    "SimulationError",
+    "Sphere",
+]
+
+BodyId = int
+
+
+class BackendError(RuntimeError):
+    """A backend could not do what was asked (bad handle, unknown joint, ...)."""
+
+
+class CapabilityError(BackendError):
+    """The backend lacks a capability (see :class:`Capabilities`)."""
+
+
+class SimulationError(BackendError):
+    """The simulation blew up (non-finite state); ends one trial, never a sweep."""
+
+
+@dataclass(frozen=True)
+class Capabilities:
+    """What a backend can do. Callers check these instead of catching errors."""
+
+    camera: bool = False  #: :meth:`Backend.render` returns images
+    mesh_collision: bool = True  #: convex mesh collision shapes
+    joint_friction: bool = True  #: :meth:`Backend.set_joint_friction`
+    mimic_joints: bool = False  #: URDF ``<mimic>`` enforced by the engine
+
+
+@dataclass(frozen=True)
+class PhysicsConfig:
+    """Engine-independent simulation settings.
+
+    Defaults are the ones DESIGN.md found to work for a 5.7 cm cube held by
+    parallel grippers on both engines.
+    """
+
+    timestep: float = 1.0 / 240.0  #: seconds per :meth:`Backend.step`
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    solver_iterations: int = 50  #: PyBullet needs >= 50 at 1/240 s for accurate twists
+    solver_velocity_iterations: int = 1
+    contact_offset: float = 0.002  #: SAPIEN/PhysX contact offset (m); 1 cm default is too large here
+    default_friction: float = 1.0
+    seed: int = 0  #: seeds any randomness a backend itself uses
+
+
+@dataclass(frozen=True)
+class Box:
+    half_extents: tuple[float, float, float]
+    pose: Pose = field(default_factory=Pose)  #: shape pose in the body frame
+
+
+@dataclass(frozen=True)
+class Sphere:
+    radius: float
+    pose: Pose = field(default_factory=Pose)
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A cylinder whose axis is the local z axis."""
+
+    radius: float
+    half_length: float
+    pose: Pose = field(default_factory=Pose)
+
+
+@dataclass(frozen=True)
+class MeshShape:
+    """A convex collision mesh (the convex hull of the vertices is used)."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    pose: Pose = field(default_factory=Pose)
+
+
+Shape = Box | Sphere | Cylinder | MeshShape
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    name: str
+    type: str  #: "revolute", "prismatic" or "continuous"
+    lower: float
+    upper: float
+    max_velocity: float
+    max_effort: float
+    parent_link: str
+    child_link: str
+
+
+@dataclass(frozen=True)
+class JointState:
+    positions: np.ndarray
+    velocities: np.ndarray
+    efforts: np.ndarray  #: applied joint torques/forces from the last step where available
+
+
+@dataclass(frozen=True)
+class Contact:
+    body_a: BodyId
+    link_a: str | None
+    body_b: BodyId
+    link_b: str | None
+    position: np.ndarray  #: world contact point (m)
+    normal: np.ndarray  #: unit normal, from B towards A
+    normal_force: float  #: N, >= 0
+    distance: float  #: signed separation (m), negative when penetrating
+
+
+@dataclass(frozen=True)
+class RayHits:
+    """Results of a batch of ray casts, one row per ray."""
+
+    hit: np.ndarray  #: (n,) bool
+    distance: np.ndarray  #: (n,) metres; ``inf`` where nothing was hit
+    point: np.ndarray  #: (n, 3) world hit points; NaN where nothing was hit
+    normal: np.ndarray  #: (n, 3) surface normals; NaN where nothing was hit
+    body: np.ndarray  #: (n,) hit body handle; -1 where nothing was hit
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    """A pinhole camera looking from ``eye`` to ``target``."""
+
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    width: int = 320
+    height: int = 240
+    fov_deg: float = 60.0
+    near: float = 0.01
+    far: float = 5.0
+
+
+class Backend(abc.ABC):
+    """One physics world. Create through the plugin manager: ``create("backend", name)``."""
+
+    name: ClassVar[str]
+    capabilities: ClassVar[Capabilities]
+
+    def __init__(self, config: PhysicsConfig | None = None) -> None:
+        self.config = config or PhysicsConfig()
+
+    # -- lifetime ------------------------------------------------------------
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Release the engine's resources. Safe to call twice."""
+
+    def __enter__(self) -> "Backend":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- time ----------------------------------------------------------------
+    @property
+    @abc.abstractmethod
+    def time(self) -> float:
+        """Simulated seconds since the world was created."""
+
+    @abc.abstractmethod
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` timesteps. Raises :class:`SimulationError` on a blow-up."""
+
+    # -- bodies --------------------------------------------------------------
+    @abc.abstractmethod
+    def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
+        """A static infinite plane (or a large static slab) with its top at ``height``."""
+
+    @abc.abstractmethod
+    def add_body(
+        self,
+        shapes: Sequence[Shape],
+        pose: Pose,
+        mass: float,
+        *,
+        friction: float | None = None,
+        fixed: bool = False,
+        name: str | None = None,
+        com: Sequence[float] | None = None,
+        inertia_diag: Sequence[float] | None = None,
+    ) -> BodyId:
+        """A rigid body made of one or more primitive shapes.
+
+        Mass is spread uniformly by volume unless ``com`` / ``inertia_diag``
+        (principal moments about the COM, in the body frame) are given.
+        """
+
+    @abc.abstractmethod
+    def load_urdf(
+        self,
+        path: str | Path,
+        base_pose: Pose,
+        *,
+        fixed_base: bool = True,
+        name: str | None = None,
+    ) -> BodyId:
+        """An articulated body from a collision-only URDF (``<visual>`` is ignored)."""
+
+    @abc.abstractmethod
+    def remove_body(self, body: BodyId) -> None:
+        """Remove a body; its handle becomes invalid (used to swap cube models in place)."""
+
+    @abc.abstractmethod
+    def get_pose(self, body: BodyId) -> Pose:
+        """The base (root link) pose of a body in the world."""
+
+    @abc.abstractmethod
+    def set_pose(self, body: BodyId, pose: Pose) -> None:
+        """Teleport a body's base; velocities are kept."""
+
+    @abc.abstractmethod
+    def get_velocity(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        """Linear (m/s) and angular (rad/s) velocity of the base, in the world frame."""
+
+    @abc.abstractmethod
+    def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
+        ...
+
+    @abc.abstractmethod
+    def get_link_pose(self, body: BodyId, link: str | None) -> Pose:
+        """World pose of a link frame (the URDF link frame, not its COM)."""
+
+    @abc.abstractmethod
+    def get_mass(self, body: BodyId) -> float:
+        """Total mass of a body (all links), kg."""
+
+    # -- joints --------------------------------------------------------------
+    @abc.abstractmethod
+    def joint_info(self, body: BodyId) -> list[JointInfo]:
+        """Movable joints of an articulated body, in a fixed order."""
+
+    def joint_names(self, body: BodyId) -> list[str]:
+        return [j.name for j in self.joint_info(body)]
+
+    @abc.abstractmethod
+    def link_names(self, body: BodyId) -> list[str]:
+        ...
+
+    @abc.abstractmethod
+    def get_joint_state(self, body: BodyId) -> JointState:
+        ...
+
+    @abc.abstractmethod
+    def set_joint_positions(
+        self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
+    ) -> None:
+        """Teleport joints (zero velocity); for resets, not for control."""
+
+    @abc.abstractmethod
+    def set_joint_targets(
+        self,
+        body: BodyId,
+        positions: Sequence[float] | None = None,
+        velocities: Sequence[float] | None = None,
+        *,
+        joints: Sequence[str] | None = None,
+        stiffness: float | Sequence[float] = 1000.0,
+        damping: float | Sequence[float] = 100.0,
+        force_limit: float | Sequence[float] | None = None,
+    ) -> None:
+        """Drive joints with a PD law ``tau = k (q* - q) + d (qd* - qd)``, capped at ``force_limit``.
+
+        ``stiffness``/``damping`` are physical gains (N·m/rad, N·m·s/rad) with
+        the same meaning on every backend; ``force_limit`` defaults to the
+        URDF effort limit. Targets persist until changed.
+        """
+
+    @abc.abstractmethod
+    def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
+        """A constant Coulomb friction torque (N·m) at passive joints.
+
+        Both engines model it as a velocity drive with target 0 capped at the
+        torque; a joint that also has a position target keeps that target.
+        """
+
+    # -- interaction -------------------------------------------------------------
+    @abc.abstractmethod
+    def contacts(self, body_a: BodyId | None = None, body_b: BodyId | None = None) -> list[Contact]:
+        """Contact points after the last step, optionally filtered to bodies A and B.
+
+        With ``body_a`` given, every contact returned has that body as A (the
+        pair is flipped, normal negated, when the engine reports it as B).
+        """
+
+    @abc.abstractmethod
+    def ray_cast(
+        self,
+        origins: np.ndarray,
+        directions: np.ndarray,
+        max_distance: float | np.ndarray,
+        *,
+        ignore_bodies: Sequence[BodyId] = (),
+    ) -> RayHits:
+        """Batched ray casts (origins, unit directions: (n, 3)) against all bodies."""
+
+    @abc.abstractmethod
+    def attach(
+        self,
+        parent: BodyId,
+        parent_link: str | None,
+        child: BodyId,
+        child_link: str | None,
+        child_in_parent: Pose,
+    ) -> int:
+        """A fixed constraint holding ``child`` at ``child_in_parent``; returns its handle."""
+
+    @abc.abstractmethod
+    def detach(self, constraint: int) -> None:
+        ...
+
+    def render(self, camera: CameraSpec) -> np.ndarray:
+        """An RGB image (height, width, 3) uint8. Backends without a renderer raise."""
+        raise CapabilityError(f"backend {self.name!r} cannot render images")
+
+    def check_finite(self, bodies: Sequence[BodyId]) -> None:
+        """Raise :class:`SimulationError` if any of the bodies' states is not finite."""
+        for b in bodies:
+            pose = self.get_pose(b)
+            lin, ang = self.get_velocity(b)
+            if not (np.all(np.isfinite(pose.p)) and np.all(np.isfinite(lin)) and np.all(np.isfinite(ang))):
+                raise SimulationError(f"body {b} has a non-finite state (simulation blew up)")

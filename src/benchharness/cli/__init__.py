@@ -1,0 +1,1 @@
+"""The ``benchharness`` command line: thin wrappers that parse, call, print."""

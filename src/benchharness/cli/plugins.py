@@ -1,0 +1,49 @@
+"""``benchharness plugins``: what is registered, by whom, and what failed to load."""
+
+from __future__ import annotations
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+from ..plugin import KIND_HOOKS, get_manager
+from .common import emit_json, json_option
+
+
+@click.command("plugins")
+@click.option(
+    "--kind",
+    type=click.Choice(list(KIND_HOOKS)),
+    default=None,
+    help="Only list items of this kind.",
+)
+@json_option
+def plugins_cmd(kind: str | None, as_json: bool) -> None:
+    """List every registered backend, robot, sensor, strategy and task.
+
+    Items come from the 'benchharness' entry-point group: built-ins and
+    third-party distributions alike. Plugins that failed to load are listed
+    with the entry point, the distribution and the reason.
+    """
+    manager = get_manager()
+    items = manager.items(kind)
+    if as_json:
+        emit_json(
+            {
+                "items": [it.describe() for it in items],
+                "errors": [
+                    {"entry_point": e.entry_point, "distribution": e.distribution, "reason": e.reason}
+                    for e in manager.errors
+                ],
+            }
+        )
+        return
+    console = Console()
+    table = Table(title="benchharness plugins")
+    for col in ("kind", "name", "distribution", "summary"):
+        table.add_column(col)
+    for it in sorted(items, key=lambda i: (list(KIND_HOOKS).index(i.kind), i.name)):
+        table.add_row(it.kind, it.name, it.distribution, it.summary)
+    console.print(table)
+    for e in manager.errors:
+        console.print(f"[red]failed:[/red] {e}")
