@@ -1,0 +1,101 @@
+"""Mass properties of a collision model made of backend primitive shapes.
+
+A backend spreads a body's mass uniformly over its shapes' volume unless it
+is given a centre of mass and inertia. The two engines disagree on how they
+do that for overlapping or mesh shapes, so we compute the properties once,
+here, and pass them explicitly: uniform density ``mass / total volume``,
+closed forms for boxes, spheres and cylinders, trimesh's exact polyhedral
+integrals for convex mesh pieces.
+
+Shapes are assumed not to overlap (our collision models are built that way:
+ring-plane hull pieces, studs *on* the brick, wings *beside* the fuselage);
+overlap would be counted twice.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import trimesh
+
+from ..backends.interface import Box, Cylinder, MeshShape, Shape, Sphere
+
+__all__ = ["MassProperties", "shape_volume", "mass_properties"]
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """Mass (kg), centre of mass and inertia tensor about it, in the body frame."""
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray  #: 3x3 about ``com``, body-frame axes (kg m^2)
+    volume: float  #: total collision volume (m^3); density = mass / volume
+
+    @property
+    def density(self) -> float:
+        return self.mass / self.volume
+
+    def principal(self) -> tuple[np.ndarray, np.ndarray]:
+        """Principal moments (ascending) and axes (columns), body frame."""
+        w, v = np.linalg.eigh(self.inertia)
+        return w, v
+
+    @property
+    def off_diagonal_ratio(self) -> float:
+        """Largest product of inertia relative to the largest moment.
+
+        The backends take a *diagonal* inertia in the body frame; where this
+        ratio is not small the diagonal alone misstates the rotational
+        dynamics (see docs/objects.md).
+        """
+        off = self.inertia - np.diag(np.diag(self.inertia))
+        return float(np.abs(off).max() / np.abs(np.diag(self.inertia)).max())
+
+
+def _local(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
+    """Volume, centroid and unit-density inertia about the centroid, in the shape frame."""
+    if isinstance(shape, Box):
+        hx, hy, hz = shape.half_extents
+        v = 8.0 * hx * hy * hz
+        inertia = v / 3.0 * np.diag([hy**2 + hz**2, hx**2 + hz**2, hx**2 + hy**2])
+        return v, np.zeros(3), inertia
+    if isinstance(shape, Sphere):
+        r = shape.radius
+        v = 4.0 / 3.0 * np.pi * r**3
+        return v, np.zeros(3), np.eye(3) * 0.4 * v * r**2
+    if isinstance(shape, Cylinder):
+        r, hl = shape.radius, shape.half_length
+        v = np.pi * r**2 * 2 * hl
+        ixx = v * (3 * r**2 + (2 * hl) ** 2) / 12.0
+        return v, np.zeros(3), np.diag([ixx, ixx, v * r**2 / 2.0])
+    if isinstance(shape, MeshShape):
+        hull = trimesh.convex.convex_hull(np.asarray(shape.vertices, float))
+        hull.density = 1.0
+        return float(hull.volume), np.asarray(hull.center_mass), np.asarray(hull.moment_inertia)
+    raise TypeError(f"not a collision shape: {type(shape).__name__}")
+
+
+def shape_volume(shape: Shape) -> float:
+    return _local(shape)[0]
+
+
+def mass_properties(shapes: Sequence[Shape], mass: float) -> MassProperties:
+    """Properties of ``shapes`` filled uniformly with total ``mass``."""
+    if not shapes:
+        raise ValueError("a collision model needs at least one shape")
+    parts = []
+    for s in shapes:
+        v, c, i_unit = _local(s)
+        rot = s.pose.rotation.as_matrix()
+        parts.append((v, s.pose.apply(c), rot @ i_unit @ rot.T))
+    vol = sum(p[0] for p in parts)
+    rho = mass / vol
+    com = sum(p[0] * p[1] for p in parts) / vol
+    inertia = np.zeros((3, 3))
+    for v, c, i_unit in parts:
+        d = c - com
+        inertia += rho * (i_unit + v * (np.dot(d, d) * np.eye(3) - np.outer(d, d)))
+    return MassProperties(mass=float(mass), com=np.asarray(com, float), inertia=inertia, volume=float(vol))

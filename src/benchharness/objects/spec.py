@@ -1,0 +1,81 @@
+"""Typed description of a benchmark object: what was published, and how we model it.
+
+The published facts (YCB id, dimensions, mass, their source) and our
+simplified geometry live side by side so that a reader checking a number
+finds its citation next to it, and a test can compare the generated model
+against the published figure it claims to reproduce.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from .boxunion import AABox
+from .sweep import SweepProfile
+
+__all__ = ["Citation", "SweepGeometry", "BoxGeometry", "Geometry", "ObjectSpec"]
+
+
+@dataclass(frozen=True)
+class Citation:
+    """Where a figure comes from (``key`` is short, ``text`` the full reference)."""
+
+    key: str
+    text: str
+
+
+@dataclass(frozen=True)
+class SweepGeometry:
+    """An elliptical-section sweep (see :mod:`.sweep`).
+
+    ``axis="z"`` turns the sweep axis from x to z (bodies of revolution stand
+    on their axis, like the real can). ``collision`` picks the collision
+    model: the exact primitive where the surface *is* one, otherwise convex
+    hull pieces of ring stacks.
+    """
+
+    profile: SweepProfile
+    axis: Literal["x", "z"] = "x"
+    collision: Literal["sphere", "cylinder", "hull_pieces"] = "hull_pieces"
+
+
+@dataclass(frozen=True)
+class BoxGeometry:
+    """A union of non-overlapping axis-aligned boxes (see :mod:`.boxunion`)."""
+
+    boxes: tuple[AABox, ...]
+
+
+Geometry = SweepGeometry | BoxGeometry
+
+
+@dataclass(frozen=True)
+class ObjectSpec:
+    """One object of the in-hand benchmark.
+
+    ``name`` is spelled as in the published data files. ``published_mm`` is
+    the YCB dimension string as published (diameter first for round objects).
+    ``bbox_mm`` gives, per axis of *our* object frame, the extent the
+    published dimensions fix (``None`` where nothing was published, e.g. the
+    banana's curvature); tests hold the generated mesh to these.
+    ``simplification`` says, for this object, how our shape departs from the
+    real one.
+    """
+
+    name: str
+    ycb_id: str
+    ycb_name: str
+    published_mm: tuple[float, ...]
+    bbox_mm: tuple[float | None, float | None, float | None]
+    mass_kg: float
+    dimension_source: Citation
+    mass_source: Citation
+    simplification: str
+    geometry: Geometry
+    aliases: tuple[str, ...] = ()
+    uncertain: str = ""  #: what could not be sourced or checked, empty when nothing
+
+    @property
+    def all_names(self) -> tuple[str, ...]:
+        return (self.name, self.ycb_name, self.ycb_name.split("_", 1)[1], *self.aliases)
