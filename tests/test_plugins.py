@@ -171,3 +171,12 @@ def test_not_found_error_lists_available_and_failures(site):
 def test_unknown_kind_is_rejected():
     with pytest.raises(ValueError, match="unknown kind"):
         PluginManager().items("gizmo")
+
+
+def test_inhand_task_sets_load_the_published_tasks():
+    m = get_manager(reload=True)
+    level1 = m.create("task", "inhand-level1")
+    assert (level1.level == 1).sum() == 100  # 10 objects x 2 initial x 5 desired grasps (paper IV-A1)
+    assert len(set(level1.object[level1.level == 1])) == 10
+    dmg = m.create("task", "inhand-level3-dmg")
+    assert sorted(dmg.object) == ["cracker box", "gelatin box", "potted meat can", "spatula"]

@@ -1,1 +1,39 @@
-"""Built-in inhand_tasks (filled in as the feature lands)."""
+"""Built-in in-hand manipulation task sets (converted from the authors' published data).
+
+Each task set is one registration whose factory reads the committed CSV
+under ``tasks/inhand/`` into a :class:`benchharness.inhand.records.TaskSet`.
+Reading is deferred to the factory so listing plugins stays cheap.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+from benchharness.paths import tasks_dir
+from benchharness.plugin import Registration, hookimpl
+
+#: name -> (file under tasks/inhand, summary)
+TASK_SETS = {
+    "inhand-level1": (
+        "level1_hand_poses.csv",
+        "In-hand Level I: desired palm pose changes on 10 YCB objects (published hand_poses.ods)",
+    ),
+    "inhand-level3-dmg": (
+        "level3_dmg_tasks.csv",
+        "In-hand Level III: contact + pose tasks for a parallel gripper (published DMG.ods)",
+    ),
+}
+
+
+def _load(filename: str, **_: object):
+    from benchharness.inhand.fileformat import read_tasks
+
+    return read_tasks(tasks_dir() / "inhand" / filename)
+
+
+@hookimpl
+def benchharness_tasks() -> list[Registration]:
+    return [
+        Registration(name, partial(_load, filename), summary, meta={"benchmark": "inhand", "file": f"tasks/inhand/{filename}"})
+        for name, (filename, summary) in TASK_SETS.items()
+    ]
