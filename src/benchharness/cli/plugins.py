@@ -42,7 +42,8 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
     table = Table(title="benchharness plugins")
     for col in ("kind", "name", "distribution", "summary"):
         table.add_column(col)
-    for it in sorted(items, key=lambda i: (list(KIND_HOOKS).index(i.kind), i.name)):
+    # stable sort: by kind, then in registration order (tiers stay 1-5, 1-10, ...)
+    for it in sorted(items, key=lambda i: list(KIND_HOOKS).index(i.kind)):
         table.add_row(it.kind, it.name, it.distribution, it.summary)
     console.print(table)
     for e in manager.errors:
