@@ -1,0 +1,738 @@
+"""The PyBullet backend (DIRECT mode, one physics client per instance).
+
+Engine-specific choices, all so that the numbers mean what they mean on SAPIEN:
+
+* PD drives: PhysX's implicit law ``f = k (q* - q') + d (v* - v')``,
+  realised by Bullet's velocity motor (solved with the contacts) whose target
+  is the backward-Euler velocity and whose force cap is the law's force at
+  rest; see :meth:`_apply_drives`.
+* Joint friction: a velocity motor with target 0 capped at the torque.
+* URDF inertias are taken from the file; self-collision is on, excluding
+  parent/child pairs (as PhysX does) and the pairs adjacent through fixed
+  links (filtered on both engines).
+* Poses are URDF link frames; PyBullet's base pose is the base's inertial
+  frame and is converted here. Base velocities are those of the base's centre
+  of mass (as on PhysX).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ..geometry import Pose
+from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, mass_properties, parse_urdf
+from .interface import (
+    Backend,
+    BackendError,
+    BodyId,
+    Box,
+    CameraSpec,
+    Capabilities,
+    Contact,
+    Cylinder,
+    JointInfo,
+    JointState,
+    MeshShape,
+    PhysicsConfig,
+    RayHits,
+    Shape,
+    SimulationError,
+    Sphere,
+)
+
+import pybullet as pb
+
+#: a base speed above this (m/s or rad/s) counts as a blow-up, as does a non-finite state
+MAX_SPEED = 1.0e4
+_RAY_BATCH = 16000
+_ATTACH_MAX_FORCE = 1.0e5
+
+
+@dataclass
+class _Body:
+    uid: int
+    name: str
+    urdf: UrdfModel | None
+    link_index: dict[str, int]  #: URDF link name -> pybullet link index (-1 = base)
+    joints: list[JointInfo]
+    joint_index: list[int]
+    base_inertial: Pose  #: base inertial frame in the base link frame
+    fixed: bool
+    # control state, per movable joint (position in self.joints)
+    target_q: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    target_v: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    kp: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    kd: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    fmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    driven: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    q_prev: np.ndarray | None = None  #: joint positions at the start of the last driven step
+    q_prev_step: int = -10
+    driven_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    driven_pb: list[int] = field(default_factory=list)
+    temp_files: list[str] = field(default_factory=list)
+
+    @property
+    def index_link(self) -> dict[int, str | None]:
+        d: dict[int, str | None] = {i: n for n, i in self.link_index.items()}
+        d[-1] = None
+        return d
+
+
+def _as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.ndim == 0:
+        return np.full(n, float(a))
+    a = a.reshape(-1)
+    if a.shape[0] != n:
+        raise BackendError(f"{what}: expected {n} values, got {a.shape[0]}")
+    return a
+
+
+class PyBulletBackend(Backend):
+    name = "pybullet"
+    capabilities = Capabilities(camera=True, mesh_collision=True, joint_friction=True, mimic_joints=False)
+
+    def __init__(self, config: PhysicsConfig | None = None) -> None:
+        super().__init__(config)
+        c = self.config
+        self._cid = pb.connect(pb.DIRECT)
+        if self._cid < 0:
+            raise BackendError("could not start a PyBullet DIRECT client")
+        pb.resetSimulation(physicsClientId=self._cid)
+        pb.setTimeStep(c.timestep, physicsClientId=self._cid)
+        pb.setGravity(*c.gravity, physicsClientId=self._cid)
+        pb.setPhysicsEngineParameter(
+            numSolverIterations=int(c.solver_iterations),
+            deterministicOverlappingPairs=1,
+            physicsClientId=self._cid,
+        )
+        self._bodies: dict[int, _Body] = {}  #: our handle -> body (PyBullet reuses its ids)
+        self._uid2h: dict[int, int] = {}
+        self._next_handle = 1
+        self._constraints: dict[int, int] = {}  #: our handle -> PyBullet constraint id
+        self._next_constraint = 1
+        self._steps = 0
+        self._closed = False
+        self._grounds: dict[int, float] = {}
+
+    # -- lifetime --------------------------------------------------------------
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        for b in self._bodies.values():
+            for f in b.temp_files:
+                try:
+                    os.unlink(f)
+                except OSError:
+                    pass
+        try:
+            pb.disconnect(physicsClientId=self._cid)
+        except pb.error:
+            pass
+
+    def __del__(self) -> None:  # pragma: no cover - best effort
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    # -- helpers ---------------------------------------------------------------
+    def _register(self, b: _Body) -> int:
+        h = self._next_handle
+        self._next_handle += 1
+        if not b.name:
+            b.name = f"body{h}"
+        self._bodies[h] = b
+        self._uid2h[b.uid] = h
+        return h
+
+    def _b(self, body: BodyId) -> _Body:
+        if self._closed:
+            raise BackendError("backend is closed")
+        try:
+            return self._bodies[body]
+        except KeyError:
+            raise BackendError(f"no body with handle {body}") from None
+
+    def _link(self, b: _Body, link: str | None) -> int:
+        if link is None or (b.urdf is not None and link == b.urdf.root_link):
+            return -1
+        try:
+            return b.link_index[link]
+        except KeyError:
+            raise BackendError(f"body {b.name!r} has no link {link!r}; links: {list(b.link_index)}") from None
+
+    def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
+        if joints is None:
+            return list(range(len(b.joints)))
+        names = [j.name for j in b.joints]
+        out = []
+        for n in joints:
+            try:
+                out.append(names.index(n))
+            except ValueError:
+                raise BackendError(f"body {b.name!r} has no movable joint {n!r}; joints: {names}") from None
+        return out
+
+    # -- time ------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        return self._steps * self.config.timestep
+
+    def step(self, n: int = 1) -> None:
+        cid = self._cid
+        driven = [b for b in self._bodies.values() if b.driven.any()]
+        dynamic = [(b.uid, h) for h, b in self._bodies.items() if not (b.fixed and not b.joints)]
+        for _ in range(int(n)):
+            for b in driven:
+                self._apply_drives(b)
+            pb.stepSimulation(physicsClientId=cid)
+            self._steps += 1
+            for uid, h in dynamic:
+                lin, ang = pb.getBaseVelocity(uid, physicsClientId=cid)
+                s = abs(lin[0]) + abs(lin[1]) + abs(lin[2]) + abs(ang[0]) + abs(ang[1]) + abs(ang[2])
+                if not s < MAX_SPEED:  # also catches NaN
+                    self._blowup(h)
+        for h, b in self._bodies.items():
+            if b.joints:
+                for st in pb.getJointStates(b.uid, b.joint_index, physicsClientId=cid):
+                    if not (math.isfinite(st[0]) and abs(st[1]) < MAX_SPEED):
+                        self._blowup(h)
+
+    def _blowup(self, h: int) -> None:
+        b = self._bodies[h]
+        raise SimulationError(
+            f"body {b.name!r} (handle {h}) has a non-finite or absurd state after step {self._steps} "
+            f"(t = {self.time:.4f} s): the simulation blew up"
+        )
+
+    def _joint_dynamics(self, b: _Body, q: list[float], v: list[float]) -> tuple[np.ndarray, np.ndarray]:
+        """Effective inertia ``1/(M^-1)_ii`` and free acceleration ``M^-1 (-bias)`` of each joint."""
+        cid = self._cid
+        m = np.asarray(pb.calculateMassMatrix(b.uid, q, physicsClientId=cid), dtype=float)
+        n = len(q)
+        off = m.shape[0] - n
+        try:
+            minv = np.linalg.inv(m)
+        except np.linalg.LinAlgError:
+            minv = np.diag(1.0 / np.maximum(np.diag(m), 1e-12))
+        meff = 1.0 / np.diag(minv)[off:]
+        if b.fixed:
+            bias = np.asarray(
+                pb.calculateInverseDynamics(b.uid, q, v, [0.0] * n, physicsClientId=cid), dtype=float
+            )
+            acc = minv @ -bias[-n:]
+        else:
+            # PyBullet has no inverse dynamics for a floating base; gravity alone gives a free
+            # floating articulation no relative joint acceleration, and Coriolis terms are neglected
+            acc = np.zeros(n)
+        return meff, acc
+
+    def _apply_drives(self, b: _Body) -> None:
+        """PhysX's implicit drive law, realised by Bullet's velocity motor inside its solver.
+
+        The implicit law ``f = k (q* - q') + d (v* - v')`` with ``q' = q + dt v'``
+        is a damper ``c = k dt + d`` towards ``v_t = (k (q* - q) + d v*) / c``.
+        With ``m`` the joint's effective inertia and ``v_ref = v + dt a`` the
+        velocity it would reach under gravity and Coriolis forces alone, free
+        motion ends the step at ``v' = (m v_ref + dt c v_t) / (m + dt c)``.
+        The motor targets ``v'`` with its force capped at the larger of
+        ``c |v_t|`` (the law's force at rest) and the force free motion needs
+        to reach ``v'``, ``m c |v_t - v_ref| / (m + dt c)``; then the force limit:
+
+        * free motion: the motor reaches ``v'``, i.e. backward Euler, stable
+          for any gains and link mass;
+        * a blocked joint (a finger on a cube) cannot move, so the motor pushes
+          with ``k (q* - q) + d v*``, as a PhysX drive does;
+        * everything is solved together with the contacts.
+        """
+        dt = self.config.timestep
+        sel = b.driven_idx
+        states = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
+        q = [s[0] for s in states]
+        v = [s[1] for s in states]
+        # The joint's actual motion over the last step. Bullet's reported velocity can carry
+        # motion that contacts undo at the position level (split impulse); feeding that back
+        # into the drive makes a blocked finger push harder and harder.
+        if b.q_prev is not None and b.q_prev_step == self._steps - 1:
+            v = ((np.asarray(q) - b.q_prev) / dt).tolist()
+        b.q_prev = np.asarray(q)
+        b.q_prev_step = self._steps
+        meff, acc = self._joint_dynamics(b, q, v)
+        qs, vs = np.asarray(q)[sel], np.asarray(v)[sel]
+        m, a = meff[sel], acc[sel]
+        k, d = b.kp[sel], b.kd[sel]
+        c = k * dt + d
+        with np.errstate(divide="ignore", invalid="ignore"):
+            vt = np.where(c > 0, (k * (b.target_q[sel] - qs) + d * b.target_v[sel]) / c, 0.0)
+        vref = vs + dt * a
+        vnext = (m * vref + dt * c * vt) / (m + dt * c)
+        # cap: the law's force at rest (what a blocked joint pushes with), or the force that
+        # free motion needs to reach v' if larger; never an explicit c |v| term, which would be
+        # unstable (period-2 chatter) on light links in contact
+        f = np.minimum(np.maximum(c * np.abs(vt), m * c * np.abs(vt - vref) / (m + dt * c)), b.fmax[sel])
+        pb.setJointMotorControlArray(
+            b.uid, b.driven_pb, pb.VELOCITY_CONTROL, targetVelocities=vnext.tolist(), forces=f.tolist(),
+            velocityGains=[1.0] * len(f), physicsClientId=self._cid,
+        )
+
+    # -- bodies ----------------------------------------------------------------
+    def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
+        cid = self._cid
+        shape = pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=[0, 0, 1], physicsClientId=cid)
+        vis = pb.createVisualShape(
+            pb.GEOM_BOX, halfExtents=[5, 5, 0.0005], visualFramePosition=[0, 0, -0.0005],
+            rgbaColor=[0.8, 0.8, 0.8, 1], physicsClientId=cid,
+        )
+        uid = pb.createMultiBody(0.0, shape, vis, basePosition=[0, 0, height], physicsClientId=cid)
+        fr = self.config.default_friction if friction is None else friction
+        pb.changeDynamics(uid, -1, lateralFriction=fr, physicsClientId=cid)
+        h = self._register(_Body(uid, "ground", None, {}, [], [], Pose(), True))
+        self._grounds[h] = float(height)
+        return h
+
+    def _shape_args(self, s: Shape, tmp: list[str]) -> dict:
+        base = {"collisionFramePosition": s.pose.p.tolist(), "collisionFrameOrientation": s.pose.q.tolist()}
+        if isinstance(s, Box):
+            return {"shapeType": pb.GEOM_BOX, "halfExtents": list(map(float, s.half_extents)), **base}
+        if isinstance(s, Sphere):
+            return {"shapeType": pb.GEOM_SPHERE, "radius": float(s.radius), **base}
+        if isinstance(s, Cylinder):
+            return {"shapeType": pb.GEOM_CYLINDER, "radius": float(s.radius), "height": 2.0 * float(s.half_length), **base}
+        if isinstance(s, MeshShape):
+            return {"shapeType": pb.GEOM_MESH, "vertices": np.asarray(s.vertices, dtype=float).tolist(), **base}
+        raise BackendError(f"unknown shape {type(s).__name__}")
+
+    def add_body(
+        self,
+        shapes: Sequence[Shape],
+        pose: Pose,
+        mass: float,
+        *,
+        friction: float | None = None,
+        fixed: bool = False,
+        name: str | None = None,
+        com: Sequence[float] | None = None,
+        inertia_diag: Sequence[float] | None = None,
+    ) -> BodyId:
+        cid = self._cid
+        shapes = list(shapes)
+        mp: MassProperties = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
+        tmp: list[str] = []
+        if len(shapes) == 1:
+            col = pb.createCollisionShape(**self._shape_args(shapes[0], tmp), physicsClientId=cid)
+        else:  # one single-link multibody; several shapes become one compound collision shape
+            col = self._compound(shapes, tmp)
+        vis = self._visuals(shapes, tmp)
+        m = 0.0 if fixed else float(mass)
+        uid = pb.createMultiBody(
+            baseMass=m,
+            baseCollisionShapeIndex=col,
+            baseVisualShapeIndex=vis,
+            basePosition=pose.apply(mp.com).tolist(),
+            baseOrientation=(pose.rotation * mp.inertial_pose.rotation).as_quat().tolist(),
+            baseInertialFramePosition=mp.com.tolist(),
+            baseInertialFrameOrientation=mp.principal.tolist(),
+            physicsClientId=cid,
+        )
+        # createMultiBody takes the base pose as the inertial frame's pose
+        pb.resetBasePositionAndOrientation(
+            uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
+        )
+        fr = self.config.default_friction if friction is None else friction
+        kw = {"lateralFriction": fr, "linearDamping": 0.0, "angularDamping": 0.0, "frictionAnchor": 1}
+        if not fixed:
+            kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
+        pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
+        if vis >= 0:
+            pb.changeVisualShape(uid, -1, rgbaColor=[0.45, 0.5, 0.6, 1], physicsClientId=cid)
+        return self._register(_Body(uid, name or "", None, {}, [], [], mp.inertial_pose, fixed, temp_files=tmp))
+
+    def _compound(self, shapes: list[Shape], tmp: list[str]) -> int:
+        cid = self._cid
+        types, half, radii, lengths, poss, orns = [], [], [], [], [], []
+        files, scales = [], []
+        for s in shapes:
+            files.append(self._hull_obj(s, tmp) if isinstance(s, MeshShape) else "")
+            scales.append([1, 1, 1])
+            if isinstance(s, MeshShape):
+                types.append(pb.GEOM_MESH); half.append([0, 0, 0]); radii.append(0); lengths.append(0)
+            elif isinstance(s, Box):
+                types.append(pb.GEOM_BOX); half.append(list(map(float, s.half_extents))); radii.append(0); lengths.append(0)
+            elif isinstance(s, Sphere):
+                types.append(pb.GEOM_SPHERE); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(0)
+            elif isinstance(s, Cylinder):
+                types.append(pb.GEOM_CYLINDER); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(2 * float(s.half_length))
+            poss.append(s.pose.p.tolist()); orns.append(s.pose.q.tolist())
+        return pb.createCollisionShapeArray(
+            shapeTypes=types, halfExtents=half, radii=radii, lengths=lengths,
+            fileNames=files, meshScales=scales,
+            collisionFramePositions=poss, collisionFrameOrientations=orns, physicsClientId=cid,
+        )
+
+    def _visuals(self, shapes: list[Shape], tmp: list[str]) -> int:
+        """Grey visual shapes mirroring the collision shapes (only the renderer sees them)."""
+        types, half, radii, lengths, files, poss, orns = [], [], [], [], [], [], []
+        for s in shapes:
+            files.append(self._hull_obj(s, tmp) if isinstance(s, MeshShape) else "")
+            if isinstance(s, MeshShape):
+                types.append(pb.GEOM_MESH); half.append([0, 0, 0]); radii.append(0); lengths.append(0)
+            elif isinstance(s, Box):
+                types.append(pb.GEOM_BOX); half.append(list(map(float, s.half_extents))); radii.append(0); lengths.append(0)
+            elif isinstance(s, Sphere):
+                types.append(pb.GEOM_SPHERE); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(0)
+            else:
+                types.append(pb.GEOM_CYLINDER); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(2 * float(s.half_length))
+            poss.append(s.pose.p.tolist()); orns.append(s.pose.q.tolist())
+        try:
+            return pb.createVisualShapeArray(
+                shapeTypes=types, halfExtents=half, radii=radii, lengths=lengths, fileNames=files,
+                meshScales=[[1, 1, 1]] * len(types), visualFramePositions=poss,
+                visualFrameOrientations=orns, physicsClientId=self._cid,
+            )
+        except pb.error:  # rendering is a nicety; physics does not need it
+            return -1
+
+    @staticmethod
+    def _hull_obj(s: MeshShape, tmp: list[str]) -> str:
+        import trimesh
+
+        hull = trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+        fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_hull_")
+        os.close(fd)
+        hull.export(fn)
+        tmp.append(fn)
+        return fn
+
+    @staticmethod
+    def _com_pose_of(link_pose: Pose, inertial: Pose) -> tuple[list[float], list[float]]:
+        w = link_pose * inertial
+        return w.p.tolist(), w.q.tolist()
+
+    def load_urdf(
+        self,
+        path: str | Path,
+        base_pose: Pose,
+        *,
+        fixed_base: bool = True,
+        name: str | None = None,
+    ) -> BodyId:
+        cid = self._cid
+        model = parse_urdf(path)
+        flags = pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_IMPLICIT_CYLINDER
+        try:
+            uid = pb.loadURDF(
+                str(Path(path).resolve()),
+                basePosition=[0, 0, 0],
+                useFixedBase=bool(fixed_base),
+                flags=flags,
+                physicsClientId=cid,
+            )
+        except pb.error as exc:
+            raise BackendError(f"PyBullet could not load {path}: {exc}") from exc
+        link_index: dict[str, int] = {}
+        joint_by_name: dict[str, int] = {}
+        for i in range(pb.getNumJoints(uid, physicsClientId=cid)):
+            info = pb.getJointInfo(uid, i, physicsClientId=cid)
+            joint_by_name[info[1].decode()] = i
+            link_index[info[12].decode()] = i
+        joints = list(model.movable)
+        jidx = [joint_by_name[j.name] for j in joints]
+        # default motors off; URDF friction/damping are not used (set_joint_friction instead)
+        if jidx:
+            pb.setJointMotorControlArray(uid, jidx, pb.VELOCITY_CONTROL, forces=[0.0] * len(jidx), physicsClientId=cid)
+        for i in range(-1, pb.getNumJoints(uid, physicsClientId=cid)):
+            pb.changeDynamics(
+                uid, i, linearDamping=0.0, angularDamping=0.0, jointDamping=0.0,
+                lateralFriction=float(self.config.default_friction), frictionAnchor=1, physicsClientId=cid,
+            )
+        # filter pairs adjacent through fixed links (PhysX does not, we do on both engines)
+        def idx(l: str) -> int:
+            return -1 if l == model.root_link else link_index[l]
+
+        for clique in model.filtered_link_pairs():
+            ls = sorted(clique)
+            for a in range(len(ls)):
+                for c in range(a + 1, len(ls)):
+                    pb.setCollisionFilterPair(uid, uid, idx(ls[a]), idx(ls[c]), 0, physicsClientId=cid)
+        di = pb.getDynamicsInfo(uid, -1, physicsClientId=cid)
+        base_inertial = Pose(di[3], di[4])
+        n = len(joints)
+        b = _Body(
+            uid, name or model.root_link, model, link_index, joints, jidx, base_inertial, bool(fixed_base),
+            target_q=np.zeros(n), target_v=np.zeros(n), kp=np.zeros(n), kd=np.zeros(n),
+            fmax=np.zeros(n), driven=np.zeros(n, dtype=bool), friction=np.zeros(n),
+        )
+        h = self._register(b)
+        self.set_pose(h, base_pose)
+        return h
+
+    def remove_body(self, body: BodyId) -> None:
+        b = self._b(body)
+        for c, pc in list(self._constraints.items()):
+            info = pb.getConstraintInfo(pc, physicsClientId=self._cid)
+            if b.uid in (info[0], info[2]):
+                self.detach(c)
+        pb.removeBody(b.uid, physicsClientId=self._cid)
+        for f in b.temp_files:
+            try:
+                os.unlink(f)
+            except OSError:
+                pass
+        del self._bodies[body]
+        self._uid2h.pop(b.uid, None)
+        self._grounds.pop(body, None)
+
+    def get_pose(self, body: BodyId) -> Pose:
+        b = self._b(body)
+        p, q = pb.getBasePositionAndOrientation(b.uid, physicsClientId=self._cid)
+        return Pose(p, q) * b.base_inertial.inv()
+
+    def set_pose(self, body: BodyId, pose: Pose) -> None:
+        b = self._b(body)
+        lin, ang = pb.getBaseVelocity(b.uid, physicsClientId=self._cid)
+        pb.resetBasePositionAndOrientation(b.uid, *self._com_pose_of(pose, b.base_inertial), physicsClientId=self._cid)
+        pb.resetBaseVelocity(b.uid, lin, ang, physicsClientId=self._cid)
+
+    def get_velocity(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        b = self._b(body)
+        lin, ang = pb.getBaseVelocity(b.uid, physicsClientId=self._cid)
+        return np.asarray(lin, dtype=float), np.asarray(ang, dtype=float)
+
+    def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
+        b = self._b(body)
+        pb.resetBaseVelocity(b.uid, list(map(float, linear)), list(map(float, angular)), physicsClientId=self._cid)
+
+    def get_link_pose(self, body: BodyId, link: str | None) -> Pose:
+        b = self._b(body)
+        i = self._link(b, link)
+        if i == -1:
+            return self.get_pose(body)
+        st = pb.getLinkState(b.uid, i, computeForwardKinematics=True, physicsClientId=self._cid)
+        return Pose(st[4], st[5])
+
+    def get_mass(self, body: BodyId) -> float:
+        b = self._b(body)
+        if b.urdf is not None:  # engines zero a fixed base's mass; report the description's
+            return b.urdf.total_mass
+        return float(
+            sum(pb.getDynamicsInfo(b.uid, i, physicsClientId=self._cid)[0] for i in range(-1, pb.getNumJoints(b.uid, physicsClientId=self._cid)))
+        )
+
+    # -- joints ----------------------------------------------------------------
+    def joint_info(self, body: BodyId) -> list[JointInfo]:
+        return list(self._b(body).joints)
+
+    def link_names(self, body: BodyId) -> list[str]:
+        b = self._b(body)
+        return list(b.urdf.links) if b.urdf else []
+
+    def get_joint_state(self, body: BodyId) -> JointState:
+        b = self._b(body)
+        if not b.joints:
+            z = np.zeros(0)
+            return JointState(z, z.copy(), z.copy())
+        st = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
+        return JointState(
+            np.array([s[0] for s in st]), np.array([s[1] for s in st]), np.array([s[3] for s in st])
+        )
+
+    def set_joint_positions(self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None) -> None:
+        b = self._b(body)
+        sel = self._joint_sel(b, joints)
+        pos = _as_array(positions, len(sel), "positions")
+        b.q_prev = None  # a teleport is not motion
+        for i, q in zip(sel, pos):
+            pb.resetJointState(b.uid, b.joint_index[i], float(q), 0.0, physicsClientId=self._cid)
+
+    def set_joint_targets(
+        self,
+        body: BodyId,
+        positions: Sequence[float] | None = None,
+        velocities: Sequence[float] | None = None,
+        *,
+        joints: Sequence[str] | None = None,
+        stiffness: float | Sequence[float] = 1000.0,
+        damping: float | Sequence[float] = 100.0,
+        force_limit: float | Sequence[float] | None = None,
+    ) -> None:
+        b = self._b(body)
+        sel = np.asarray(self._joint_sel(b, joints), dtype=int)
+        n = len(sel)
+        if n == 0:
+            return
+        k = _as_array(stiffness, n, "stiffness")
+        d = _as_array(damping, n, "damping")
+        if force_limit is None:
+            f = np.array([b.joints[i].max_effort for i in sel])
+        else:
+            f = _as_array(force_limit, n, "force_limit")
+        f = np.where(np.isfinite(f), f, 1.0e9)
+        if positions is None:
+            st = self.get_joint_state(body)
+            q = st.positions[sel] if velocities is not None else st.positions[sel]
+            if velocities is not None:
+                k = np.zeros(n)  # a pure velocity drive
+        else:
+            q = _as_array(positions, n, "positions")
+        v = np.zeros(n) if velocities is None else _as_array(velocities, n, "velocities")
+        b.target_q[sel], b.target_v[sel], b.kp[sel], b.kd[sel], b.fmax[sel] = q, v, k, d, f
+        b.driven[sel] = True
+        b.driven_idx = np.nonzero(b.driven)[0]
+        b.driven_pb = [b.joint_index[i] for i in b.driven_idx]
+
+    def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
+        b = self._b(body)
+        sel = self._joint_sel(b, joints)
+        t = _as_array(torques, len(sel), "torques")
+        for i, tau in zip(sel, t):
+            b.friction[i] = float(tau)
+            if not b.driven[i]:
+                pb.setJointMotorControl2(
+                    b.uid, b.joint_index[i], pb.VELOCITY_CONTROL, targetVelocity=0.0, force=float(tau),
+                    velocityGain=1.0, physicsClientId=self._cid,
+                )
+
+    # -- interaction -----------------------------------------------------------
+    def contacts(self, body_a: BodyId | None = None, body_b: BodyId | None = None) -> list[Contact]:
+        kw = {}
+        if body_a is not None:
+            kw["bodyA"] = self._b(body_a).uid
+        if body_b is not None:
+            kw["bodyB"] = self._b(body_b).uid
+        out = []
+        for c in pb.getContactPoints(**kw, physicsClientId=self._cid):
+            a, bb = self._uid2h.get(c[1]), self._uid2h.get(c[2])
+            if a is None or bb is None:
+                continue
+            la, lb = self._bodies[a].index_link.get(c[3]), self._bodies[bb].index_link.get(c[4])
+            pos = 0.5 * (np.asarray(c[5]) + np.asarray(c[6]))
+            nrm = np.asarray(c[7], dtype=float)
+            con = Contact(a, la, bb, lb, pos, nrm, max(0.0, float(c[9])), float(c[8]))
+            if (body_a is not None and a != body_a) or (body_a is None and body_b is not None and bb != body_b):
+                con = Contact(bb, lb, a, la, pos, -nrm, con.normal_force, con.distance)
+            if body_a is not None and con.body_a != body_a or body_b is not None and con.body_b != body_b:
+                continue
+            out.append(con)
+        return out
+
+    def ray_cast(
+        self,
+        origins: np.ndarray,
+        directions: np.ndarray,
+        max_distance: float | np.ndarray,
+        *,
+        ignore_bodies: Sequence[BodyId] = (),
+    ) -> RayHits:
+        o = np.atleast_2d(np.asarray(origins, dtype=float))
+        dvec = np.atleast_2d(np.asarray(directions, dtype=float))
+        n = o.shape[0]
+        dvec = dvec / np.linalg.norm(dvec, axis=1, keepdims=True)
+        maxd = np.broadcast_to(np.asarray(max_distance, dtype=float), (n,)).copy()
+        ignore = set(int(x) for x in ignore_bodies)
+        ignore_uid = {self._bodies[h].uid for h in ignore if h in self._bodies}
+        hit = np.zeros(n, dtype=bool)
+        dist = np.full(n, np.inf)
+        point = np.full((n, 3), np.nan)
+        normal = np.full((n, 3), np.nan)
+        body = np.full(n, -1, dtype=int)
+        start = np.zeros(n)  # distance already travelled
+        todo = np.arange(n)
+        for _ in range(64):
+            if todo.size == 0:
+                break
+            nxt = []
+            for c0 in range(0, todo.size, _RAY_BATCH):
+                idx = todo[c0 : c0 + _RAY_BATCH]
+                fr = o[idx] + dvec[idx] * start[idx, None]
+                to = o[idx] + dvec[idx] * maxd[idx, None]
+                res = pb.rayTestBatch(fr.tolist(), to.tolist(), physicsClientId=self._cid)
+                for i, r in zip(idx, res):
+                    uid = r[0]
+                    if uid < 0 or uid not in self._uid2h:
+                        continue
+                    d_hit = start[i] + r[2] * (maxd[i] - start[i])
+                    if uid in ignore_uid:
+                        start[i] = d_hit + 1e-4  # rays starting inside a convex shape do not hit it
+                        if start[i] < maxd[i]:
+                            nxt.append(i)
+                        continue
+                    hit[i] = True
+                    dist[i] = d_hit
+                    point[i] = r[3]
+                    normal[i] = r[4]
+                    body[i] = self._uid2h[uid]
+            todo = np.asarray(nxt, dtype=int)
+        ground_ray_fixup(self._grounds, ignore, o, dvec, maxd, hit, dist, point, normal, body)
+        return RayHits(hit, dist, point, normal, body)
+
+    def attach(
+        self,
+        parent: BodyId,
+        parent_link: str | None,
+        child: BodyId,
+        child_link: str | None,
+        child_in_parent: Pose,
+    ) -> int:
+        pbody, cbody = self._b(parent), self._b(child)
+        pi, ci = self._link(pbody, parent_link), self._link(cbody, child_link)
+        pin = self._inertial(pbody, pi)
+        cin = self._inertial(cbody, ci)
+        fp = pin.inv() * child_in_parent
+        fc = cin.inv()
+        cid = pb.createConstraint(
+            pbody.uid, pi, cbody.uid, ci, pb.JOINT_FIXED, [0, 0, 0],
+            parentFramePosition=fp.p.tolist(), childFramePosition=fc.p.tolist(),
+            parentFrameOrientation=fp.q.tolist(), childFrameOrientation=fc.q.tolist(),
+            physicsClientId=self._cid,
+        )
+        pb.changeConstraint(cid, maxForce=_ATTACH_MAX_FORCE, physicsClientId=self._cid)
+        h = self._next_constraint
+        self._next_constraint += 1
+        self._constraints[h] = cid
+        return h
+
+    def check_finite(self, bodies: Sequence[BodyId]) -> None:
+        for h in bodies:
+            b = self._b(h)
+            p, q = pb.getBasePositionAndOrientation(b.uid, physicsClientId=self._cid)
+            lin, ang = pb.getBaseVelocity(b.uid, physicsClientId=self._cid)
+            vals = list(p) + list(q) + list(lin) + list(ang)
+            if b.joints:
+                for st in pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid):
+                    vals += [st[0], st[1]]
+            if not all(math.isfinite(v) for v in vals):
+                raise SimulationError(f"body {b.name!r} (handle {h}) has a non-finite state (simulation blew up)")
+
+    def _inertial(self, b: _Body, link: int) -> Pose:
+        if link == -1:
+            return b.base_inertial
+        di = pb.getDynamicsInfo(b.uid, link, physicsClientId=self._cid)
+        return Pose(di[3], di[4])
+
+    def detach(self, constraint: int) -> None:
+        try:
+            pc = self._constraints.pop(constraint)
+        except KeyError:
+            raise BackendError(f"no attachment with handle {constraint}") from None
+        pb.removeConstraint(pc, physicsClientId=self._cid)
+
+    def render(self, camera: CameraSpec) -> np.ndarray:
+        view = pb.computeViewMatrix(camera.eye, camera.target, camera.up, physicsClientId=self._cid)
+        proj = pb.computeProjectionMatrixFOV(
+            camera.fov_deg, camera.width / camera.height, camera.near, camera.far, physicsClientId=self._cid
+        )
+        _, _, rgba, _, _ = pb.getCameraImage(
+            camera.width, camera.height, view, proj, renderer=pb.ER_TINY_RENDERER, physicsClientId=self._cid
+        )
+        img = np.asarray(rgba, dtype=np.uint8).reshape(camera.height, camera.width, 4)
+        return img[:, :, :3].copy()

@@ -1,0 +1,701 @@
+"""The SAPIEN 3 backend (PhysX 5 on the CPU, one ``sapien.Scene`` per instance).
+
+Headless machines have no render device, so this backend never creates one:
+the ground has no visual, URDFs are loaded from a collision-only copy, and
+:meth:`render` raises :class:`CapabilityError`.
+
+Engine-specific choices (so that the numbers mean what they mean on PyBullet):
+
+* TGS solver, ``PhysicsConfig.solver_iterations`` position iterations;
+  shape ``contact_offset`` from the config and ``rest_offset = 0``.
+* PD drives are PhysX joint drives (implicit spring-damper, ``force`` mode).
+* Joint friction: a velocity drive, target 0, large damping, force limit =
+  the torque. The URDF's ``<dynamics>`` (damping, friction) is zeroed, as on PyBullet.
+* Links joined through fixed links are filtered from colliding (collision
+  group word 2 bits, word 3 = the body's handle), as on PyBullet.
+* SAPIEN quaternions are (w, x, y, z); converted here only.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..geometry import Pose
+from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, collision_only_copy, mass_properties, parse_urdf
+from .interface import (
+    Backend,
+    BackendError,
+    BodyId,
+    Box,
+    Capabilities,
+    Contact,
+    Cylinder,
+    JointInfo,
+    JointState,
+    MeshShape,
+    PhysicsConfig,
+    RayHits,
+    Shape,
+    SimulationError,
+    Sphere,
+)
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")  # "Failed to find system libvulkan" on headless machines
+    import sapien
+    import sapien.physx as physx
+
+#: a speed above this (m/s or rad/s) counts as a blow-up, as does a non-finite state
+MAX_SPEED = 1.0e4
+_FRICTION_DAMPING = 1.0e4  #: damping of the velocity drive that models Coulomb joint friction
+_ATTACH_STIFFNESS = 1.0e7
+_ATTACH_DAMPING = 1.0e4
+_ATTACH_MAX_FORCE = 1.0e5
+# x axis -> z axis: SAPIEN cylinders run along x, ours along z
+_X_TO_Z = Pose([0, 0, 0], [0.0, -math.sqrt(0.5), 0.0, math.sqrt(0.5)])
+
+
+def _sp(pose: Pose) -> "sapien.Pose":
+    q = pose.q
+    return sapien.Pose([float(x) for x in pose.p], [float(q[3]), float(q[0]), float(q[1]), float(q[2])])
+
+
+def _bp(pose: "sapien.Pose") -> Pose:
+    q = pose.q
+    return Pose(np.asarray(pose.p, dtype=float), [q[1], q[2], q[3], q[0]])
+
+
+@dataclass
+class _Body:
+    handle: int
+    name: str
+    entity: Any = None  #: actor entity (rigid bodies)
+    component: Any = None  #: PhysxRigidDynamicComponent / PhysxRigidStaticComponent
+    articulation: Any = None
+    urdf: UrdfModel | None = None
+    links: dict[str, Any] = field(default_factory=dict)  #: URDF name -> link component
+    joints: list[JointInfo] = field(default_factory=list)
+    sjoints: list[Any] = field(default_factory=list)  #: SAPIEN joints in our order
+    perm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  #: ours -> active index
+    fixed: bool = False
+    driven: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    target_q: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    target_v: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    kp: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    kd: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    fmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    drive_props: dict[int, tuple[float, float, float]] = field(default_factory=dict)
+    temp_files: list[str] = field(default_factory=list)
+
+    @property
+    def root(self) -> Any:
+        return self.articulation.root if self.articulation is not None else self.component
+
+    def components(self) -> list[Any]:
+        if self.articulation is not None:
+            return list(self.articulation.links)
+        return [self.component]
+
+
+def _as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.ndim == 0:
+        return np.full(n, float(a))
+    a = a.reshape(-1)
+    if a.shape[0] != n:
+        raise BackendError(f"{what}: expected {n} values, got {a.shape[0]}")
+    return a
+
+
+class SapienBackend(Backend):
+    name = "sapien"
+    capabilities = Capabilities(camera=False, mesh_collision=True, joint_friction=True, mimic_joints=False)
+
+    def __init__(self, config: PhysicsConfig | None = None) -> None:
+        super().__init__(config)
+        c = self.config
+        physx.set_scene_config(gravity=np.asarray(c.gravity, dtype=np.float32), enable_tgs=True, cpu_workers=0)
+        self._apply_global_config()
+        self._system = physx.PhysxCpuSystem()
+        self._scene = sapien.Scene([self._system])
+        self._scene.set_timestep(c.timestep)
+        self._bodies: dict[int, _Body] = {}
+        self._entity_map: dict[int, tuple[int, str | None]] = {}  # per_scene_id -> (handle, link)
+        self._constraints: dict[int, Any] = {}
+        self._next = 1
+        self._next_constraint = 1
+        self._steps = 0
+        self._closed = False
+        self._grounds: dict[int, float] = {}
+        self._materials: dict[float, Any] = {}
+
+    def _apply_global_config(self) -> None:
+        """SAPIEN's shape/body settings are process-wide defaults read at creation: set them each time."""
+        c = self.config
+        physx.set_shape_config(contact_offset=float(c.contact_offset), rest_offset=0.0)
+        physx.set_body_config(
+            solver_position_iterations=int(c.solver_iterations),
+            solver_velocity_iterations=int(c.solver_velocity_iterations),
+            sleep_threshold=0.0,  # no sleeping: Bullet multibodies do not sleep either
+        )
+
+    def _material(self, friction: float | None) -> Any:
+        f = float(self.config.default_friction if friction is None else friction)
+        if f not in self._materials:
+            self._materials[f] = physx.PhysxMaterial(f, f, 0.0)
+        return self._materials[f]
+
+    # -- lifetime --------------------------------------------------------------
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        for b in self._bodies.values():
+            for f in b.temp_files:
+                try:
+                    os.unlink(f)
+                except OSError:
+                    pass
+        self._bodies.clear()
+        self._constraints.clear()
+        self._entity_map.clear()
+        try:
+            self._scene.clear()
+        except Exception:  # noqa: BLE001 - best effort
+            pass
+        self._scene = None
+        self._system = None
+
+    # -- helpers ---------------------------------------------------------------
+    def _b(self, body: BodyId) -> _Body:
+        if self._closed:
+            raise BackendError("backend is closed")
+        try:
+            return self._bodies[body]
+        except KeyError:
+            raise BackendError(f"no body with handle {body}") from None
+
+    def _link(self, b: _Body, link: str | None) -> Any:
+        if link is None:
+            return b.root
+        if b.articulation is None:
+            raise BackendError(f"body {b.name!r} has no links; use link=None")
+        try:
+            return b.links[link]
+        except KeyError:
+            raise BackendError(f"body {b.name!r} has no link {link!r}; links: {list(b.links)}") from None
+
+    def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
+        if joints is None:
+            return list(range(len(b.joints)))
+        names = [j.name for j in b.joints]
+        out = []
+        for n in joints:
+            try:
+                out.append(names.index(n))
+            except ValueError:
+                raise BackendError(f"body {b.name!r} has no movable joint {n!r}; joints: {names}") from None
+        return out
+
+    def _register(self, b: _Body) -> int:
+        self._bodies[b.handle] = b
+        if b.articulation is not None:
+            for name, comp in b.links.items():
+                link = None if name == b.urdf.root_link else name
+                self._entity_map[comp.entity.per_scene_id] = (b.handle, link)
+        else:
+            self._entity_map[b.entity.per_scene_id] = (b.handle, None)
+        return b.handle
+
+    def _new_handle(self) -> int:
+        h = self._next
+        self._next += 1
+        return h
+
+    # -- time ------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        return self._steps * self.config.timestep
+
+    def step(self, n: int = 1) -> None:
+        if self._closed:
+            raise BackendError("backend is closed")
+        roots = [(h, b.root) for h, b in self._bodies.items() if not (b.fixed and b.articulation is None)]
+        arts = [(h, b.articulation) for h, b in self._bodies.items() if b.articulation is not None]
+        for _ in range(int(n)):
+            self._scene.step()
+            self._steps += 1
+            for h, comp in roots:
+                lv = comp.linear_velocity
+                av = comp.angular_velocity
+                s = abs(lv[0]) + abs(lv[1]) + abs(lv[2]) + abs(av[0]) + abs(av[1]) + abs(av[2])
+                if not s < MAX_SPEED:
+                    self._blowup(h)
+        for h, art in arts:
+            if not (np.all(np.isfinite(art.qpos)) and np.all(np.abs(art.qvel) < MAX_SPEED)):
+                self._blowup(h)
+
+    def _blowup(self, h: int) -> None:
+        raise SimulationError(
+            f"body {self._bodies[h].name!r} (handle {h}) has a non-finite or absurd state after step "
+            f"{self._steps} (t = {self.time:.4f} s): the simulation blew up"
+        )
+
+    # -- bodies ----------------------------------------------------------------
+    def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
+        self._apply_global_config()
+        ent = self._scene.add_ground(float(height), render=False, material=self._material(friction))
+        h = self._new_handle()
+        comp = ent.find_component_by_type(physx.PhysxRigidStaticComponent)
+        self._grounds[h] = float(height)
+        return self._register(_Body(h, "ground", entity=ent, component=comp, fixed=True))
+
+    def add_body(
+        self,
+        shapes: Sequence[Shape],
+        pose: Pose,
+        mass: float,
+        *,
+        friction: float | None = None,
+        fixed: bool = False,
+        name: str | None = None,
+        com: Sequence[float] | None = None,
+        inertia_diag: Sequence[float] | None = None,
+    ) -> BodyId:
+        self._apply_global_config()
+        shapes = list(shapes)
+        mp: MassProperties = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
+        mat = self._material(friction)
+        builder = self._scene.create_actor_builder()
+        tmp: list[str] = []
+        for s in shapes:
+            if isinstance(s, Box):
+                builder.add_box_collision(_sp(s.pose), [float(x) for x in s.half_extents], material=mat)
+            elif isinstance(s, Sphere):
+                builder.add_sphere_collision(_sp(s.pose), float(s.radius), material=mat)
+            elif isinstance(s, Cylinder):
+                builder.add_cylinder_collision(_sp(s.pose * _X_TO_Z), float(s.radius), float(s.half_length), material=mat)
+            elif isinstance(s, MeshShape):
+                import trimesh
+
+                hull = trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+                fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_hull_")
+                os.close(fd)
+                hull.export(fn)
+                tmp.append(fn)
+                builder.add_convex_collision_from_file(fn, _sp(s.pose), material=mat)
+            else:
+                raise BackendError(f"unknown shape {type(s).__name__}")
+        builder.set_initial_pose(_sp(pose))
+        h = self._new_handle()
+        nm = name or f"body{h}"
+        if fixed:
+            ent = builder.build_static(name=nm)
+            comp = ent.find_component_by_type(physx.PhysxRigidStaticComponent)
+        else:
+            builder.set_mass_and_inertia(float(mass), _sp(mp.inertial_pose), [float(x) for x in mp.inertia_diag])
+            ent = builder.build(name=nm)
+            comp = ent.find_component_by_type(physx.PhysxRigidDynamicComponent)
+            comp.linear_damping = 0.0  # no artificial damping (PhysX defaults to 0.05 angular)
+            comp.angular_damping = 0.0
+        return self._register(_Body(h, nm, entity=ent, component=comp, fixed=fixed, temp_files=tmp))
+
+    def load_urdf(
+        self,
+        path: str | Path,
+        base_pose: Pose,
+        *,
+        fixed_base: bool = True,
+        name: str | None = None,
+    ) -> BodyId:
+        self._apply_global_config()
+        model = parse_urdf(path)
+        copy = collision_only_copy(path)
+        loader = self._scene.create_urdf_loader()
+        loader.fix_root_link = bool(fixed_base)
+        f = float(self.config.default_friction)
+        loader.set_material(f, f, 0.0)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                art = loader.load(copy, srdf_file="")
+        except Exception as exc:  # noqa: BLE001
+            raise BackendError(f"SAPIEN could not load {path}: {exc}") from exc
+        finally:
+            try:
+                os.unlink(copy)
+            except OSError:
+                pass
+        if art is None:
+            raise BackendError(f"SAPIEN could not load {path}")
+        h = self._new_handle()
+        links = {l.name: l for l in art.links}
+        active = [j.name for j in art.active_joints]
+        joints = list(model.movable)
+        perm = np.array([active.index(j.name) for j in joints], dtype=int)
+        sjoints = [art.active_joints[i] for i in perm]
+        for comp in art.links:
+            comp.linear_damping = 0.0
+            comp.angular_damping = 0.0
+        for j in sjoints:  # the URDF's <dynamics> is not used; see set_joint_friction
+            j.set_drive_property(0.0, 0.0, 0.0)
+            j.set_friction(0.0)
+        # filter links adjacent through fixed links; word 3 scopes the bits to this body
+        cliques = model.filtered_link_pairs()
+        for comp in art.links:
+            for shape in comp.collision_shapes:
+                g = list(shape.collision_groups)
+                g[3] = h
+                shape.set_collision_groups(g)
+        for bit, clique in enumerate(cliques):
+            if bit >= 32:
+                warnings.warn(f"{path}: more than 32 fixed-link collision filters; the rest are not applied")
+                break
+            for ln in clique:
+                for shape in links[ln].collision_shapes:
+                    g = list(shape.collision_groups)
+                    g[2] |= 1 << bit
+                    shape.set_collision_groups(g)
+        n = len(joints)
+        b = _Body(
+            h, name or model.root_link, articulation=art, urdf=model, links=links, joints=joints,
+            sjoints=sjoints, perm=perm, fixed=bool(fixed_base),
+            driven=np.zeros(n, dtype=bool), target_q=np.zeros(n), target_v=np.zeros(n), kp=np.zeros(n),
+            kd=np.zeros(n), fmax=np.zeros(n), friction=np.zeros(n),
+        )
+        art.set_root_pose(_sp(base_pose))
+        art.set_qpos(np.zeros(art.dof, dtype=np.float32))
+        return self._register(b)
+
+    def remove_body(self, body: BodyId) -> None:
+        b = self._b(body)
+        for c, (drive, pb_, cb_) in list(self._constraints.items()):
+            if body in (pb_, cb_):
+                self.detach(c)
+        if b.articulation is not None:
+            for comp in b.links.values():
+                self._entity_map.pop(comp.entity.per_scene_id, None)
+            self._scene.remove_articulation(b.articulation)
+        else:
+            self._entity_map.pop(b.entity.per_scene_id, None)
+            self._scene.remove_entity(b.entity)
+        for f in b.temp_files:
+            try:
+                os.unlink(f)
+            except OSError:
+                pass
+        del self._bodies[body]
+        self._grounds.pop(body, None)
+
+    def get_pose(self, body: BodyId) -> Pose:
+        b = self._b(body)
+        return _bp(b.root.entity_pose)
+
+    def set_pose(self, body: BodyId, pose: Pose) -> None:
+        b = self._b(body)
+        if b.articulation is not None:
+            b.articulation.set_root_pose(_sp(pose))
+        else:
+            b.entity.set_pose(_sp(pose))
+            if not b.fixed:
+                b.component.wake_up()
+
+    def get_velocity(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        b = self._b(body)
+        if b.fixed and b.articulation is None:
+            return np.zeros(3), np.zeros(3)
+        r = b.root
+        return np.asarray(r.linear_velocity, dtype=float), np.asarray(r.angular_velocity, dtype=float)
+
+    def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
+        b = self._b(body)
+        lin = np.asarray(linear, dtype=np.float32)
+        ang = np.asarray(angular, dtype=np.float32)
+        if b.articulation is not None:
+            b.articulation.set_root_linear_velocity(lin)
+            b.articulation.set_root_angular_velocity(ang)
+        elif not b.fixed:
+            b.component.set_linear_velocity(lin)
+            b.component.set_angular_velocity(ang)
+            b.component.wake_up()
+
+    def get_link_pose(self, body: BodyId, link: str | None) -> Pose:
+        b = self._b(body)
+        return _bp(self._link(b, link).entity_pose)
+
+    def get_mass(self, body: BodyId) -> float:
+        b = self._b(body)
+        if b.urdf is not None:  # engines zero a fixed base's mass; report the description's
+            return b.urdf.total_mass
+        if b.fixed and b.articulation is None:
+            return 0.0
+        return float(sum(c.mass for c in b.components()))
+
+    # -- joints ----------------------------------------------------------------
+    def joint_info(self, body: BodyId) -> list[JointInfo]:
+        return list(self._b(body).joints)
+
+    def link_names(self, body: BodyId) -> list[str]:
+        b = self._b(body)
+        return list(b.urdf.links) if b.urdf else []
+
+    def get_joint_state(self, body: BodyId) -> JointState:
+        b = self._b(body)
+        if b.articulation is None or not b.joints:
+            z = np.zeros(0)
+            return JointState(z, z.copy(), z.copy())
+        art = b.articulation
+        q = np.asarray(art.qpos, dtype=float)[b.perm]
+        v = np.asarray(art.qvel, dtype=float)[b.perm]
+        # PhysX does not report drive forces: evaluate the (capped) drive law at the current state
+        eff = np.where(
+            b.driven,
+            np.clip(b.kp * (b.target_q - q) + b.kd * (b.target_v - v), -b.fmax, b.fmax),
+            -np.sign(v) * b.friction,
+        )
+        return JointState(q, v, eff)
+
+    def set_joint_positions(self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None) -> None:
+        b = self._b(body)
+        sel = self._joint_sel(b, joints)
+        pos = _as_array(positions, len(sel), "positions")
+        art = b.articulation
+        q = np.asarray(art.qpos, dtype=np.float32).copy()
+        v = np.asarray(art.qvel, dtype=np.float32).copy()
+        for i, x in zip(sel, pos):
+            q[b.perm[i]] = x
+            v[b.perm[i]] = 0.0
+        art.set_qpos(q)
+        art.set_qvel(v)
+
+    def set_joint_targets(
+        self,
+        body: BodyId,
+        positions: Sequence[float] | None = None,
+        velocities: Sequence[float] | None = None,
+        *,
+        joints: Sequence[str] | None = None,
+        stiffness: float | Sequence[float] = 1000.0,
+        damping: float | Sequence[float] = 100.0,
+        force_limit: float | Sequence[float] | None = None,
+    ) -> None:
+        b = self._b(body)
+        sel = np.asarray(self._joint_sel(b, joints), dtype=int)
+        n = len(sel)
+        if n == 0:
+            return
+        k = _as_array(stiffness, n, "stiffness")
+        d = _as_array(damping, n, "damping")
+        if force_limit is None:
+            f = np.array([b.joints[i].max_effort for i in sel])
+        else:
+            f = _as_array(force_limit, n, "force_limit")
+        f = np.where(np.isfinite(f), f, 1.0e9)
+        if positions is None:
+            q = self.get_joint_state(body).positions[sel]
+            if velocities is not None:
+                k = np.zeros(n)
+        else:
+            q = _as_array(positions, n, "positions")
+        v = np.zeros(n) if velocities is None else _as_array(velocities, n, "velocities")
+        b.target_q[sel], b.target_v[sel], b.kp[sel], b.kd[sel], b.fmax[sel] = q, v, k, d, f
+        b.driven[sel] = True
+        for i, qi, vi, ki, di, fi in zip(sel, q, v, k, d, f):
+            j = b.sjoints[i]
+            prop = (float(ki), float(di), float(fi))
+            if b.drive_props.get(int(i)) != prop:  # the setter is slow; targets change every step
+                j.set_drive_property(*prop, "force")
+                b.drive_props[int(i)] = prop
+            j.set_drive_target(float(qi))
+            j.set_drive_velocity_target(float(vi))
+
+    def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
+        b = self._b(body)
+        sel = self._joint_sel(b, joints)
+        t = _as_array(torques, len(sel), "torques")
+        for i, tau in zip(sel, t):
+            b.friction[i] = float(tau)
+            if not b.driven[i]:
+                j = b.sjoints[i]
+                prop = (0.0, _FRICTION_DAMPING if tau > 0 else 0.0, float(tau))
+                j.set_drive_property(*prop, "force")
+                b.drive_props[int(i)] = prop
+                j.set_drive_velocity_target(0.0)
+
+    # -- interaction -----------------------------------------------------------
+    def contacts(self, body_a: BodyId | None = None, body_b: BodyId | None = None) -> list[Contact]:
+        if body_a is not None:
+            self._b(body_a)
+        if body_b is not None:
+            self._b(body_b)
+        inv_dt = 1.0 / self.config.timestep
+        out: list[Contact] = []
+        emap = self._entity_map
+        for c in self._system.get_contacts():
+            e0 = emap.get(c.bodies[0].entity.per_scene_id)
+            e1 = emap.get(c.bodies[1].entity.per_scene_id)
+            if e0 is None or e1 is None:
+                continue
+            # PhysX: the normal points from the second body towards the first
+            (ha, la), (hb, lb), sign = e0, e1, 1.0
+            if (body_a is not None and ha != body_a) or (body_a is None and body_b is not None and hb != body_b):
+                (ha, la), (hb, lb), sign = e1, e0, -1.0
+            if body_a is not None and ha != body_a:
+                continue
+            if body_b is not None and hb != body_b:
+                continue
+            for p in c.points:
+                nrm = sign * np.asarray(p.normal, dtype=float)
+                imp = np.asarray(p.impulse, dtype=float)
+                fn = abs(float(np.dot(imp, p.normal))) * inv_dt
+                out.append(Contact(ha, la, hb, lb, np.asarray(p.position, dtype=float), nrm, fn, float(p.separation)))
+        return out
+
+    def ray_cast(
+        self,
+        origins: np.ndarray,
+        directions: np.ndarray,
+        max_distance: float | np.ndarray,
+        *,
+        ignore_bodies: Sequence[BodyId] = (),
+    ) -> RayHits:
+        o = np.atleast_2d(np.asarray(origins, dtype=float))
+        dvec = np.atleast_2d(np.asarray(directions, dtype=float))
+        n = o.shape[0]
+        dvec = dvec / np.linalg.norm(dvec, axis=1, keepdims=True)
+        maxd = np.broadcast_to(np.asarray(max_distance, dtype=float), (n,))
+        ignore = set(int(x) for x in ignore_bodies)
+        hit = np.zeros(n, dtype=bool)
+        dist = np.full(n, np.inf)
+        point = np.full((n, 3), np.nan)
+        normal = np.full((n, 3), np.nan)
+        body = np.full(n, -1, dtype=int)
+        emap = self._entity_map
+        for i in range(n):
+            start = 0.0
+            for _ in range(64):
+                if start >= maxd[i]:
+                    break
+                org = o[i] + dvec[i] * start
+                r = self._system.raycast(org.astype(np.float32), dvec[i].astype(np.float32), float(maxd[i] - start))
+                if r is None:
+                    break
+                ent = emap.get(r.component.entity.per_scene_id)
+                d_hit = start + float(r.distance)
+                if ent is not None and ent[0] in ignore:
+                    exit_d = _ray_exit(r.shape, _bp(r.component.entity_pose), org, dvec[i])
+                    start = start + max(float(r.distance), exit_d) + 1e-6
+                    continue
+                hit[i] = True
+                dist[i] = d_hit
+                point[i] = np.asarray(r.position, dtype=float)
+                normal[i] = np.asarray(r.normal, dtype=float)
+                body[i] = ent[0] if ent is not None else -1
+                break
+        ground_ray_fixup(self._grounds, ignore, o, dvec, maxd, hit, dist, point, normal, body)
+        return RayHits(hit, dist, point, normal, body)
+
+    def attach(
+        self,
+        parent: BodyId,
+        parent_link: str | None,
+        child: BodyId,
+        child_link: str | None,
+        child_in_parent: Pose,
+    ) -> int:
+        pb_, cb_ = self._b(parent), self._b(child)
+        pcomp, ccomp = self._link(pb_, parent_link), self._link(cb_, child_link)
+        drive = physx.PhysxDriveComponent(ccomp)
+        drive.parent = pcomp
+        drive.pose_in_parent = _sp(child_in_parent)
+        drive.pose_in_child = sapien.Pose()
+        for ax in ("x", "y", "z"):
+            getattr(drive, f"set_drive_property_{ax}")(_ATTACH_STIFFNESS, _ATTACH_DAMPING, _ATTACH_MAX_FORCE)
+        drive.set_drive_property_slerp(_ATTACH_STIFFNESS, _ATTACH_DAMPING, _ATTACH_MAX_FORCE)
+        drive.set_drive_target(sapien.Pose())
+        ccomp.entity.add_component(drive)
+        h = self._next_constraint
+        self._next_constraint += 1
+        self._constraints[h] = (drive, parent, child)
+        return h
+
+    def detach(self, constraint: int) -> None:
+        try:
+            drive, _, _ = self._constraints.pop(constraint)
+        except KeyError:
+            raise BackendError(f"no attachment with handle {constraint}") from None
+        body = drive.entity.find_component_by_type(physx.PhysxRigidBodyComponent)
+        drive.entity.remove_component(drive)
+        for comp in (body, drive.parent):
+            if comp is not None and hasattr(comp, "wake_up"):
+                comp.wake_up()
+
+    def check_finite(self, bodies: Sequence[BodyId]) -> None:
+        for h in bodies:
+            b = self._b(h)
+            r = b.root
+            arrs = [r.entity_pose.p, r.entity_pose.q]
+            if not (b.fixed and b.articulation is None):
+                arrs += [r.linear_velocity, r.angular_velocity]
+            if b.articulation is not None:
+                arrs += [b.articulation.qpos, b.articulation.qvel]
+            if not all(np.all(np.isfinite(a)) for a in arrs):
+                raise SimulationError(f"body {b.name!r} (handle {h}) has a non-finite state (simulation blew up)")
+
+
+def _ray_exit(shape: Any, body_pose: Pose, origin: np.ndarray, direction: np.ndarray) -> float:
+    """Distance along the ray at which it leaves ``shape`` (0 if it never enters)."""
+    world = body_pose * _bp(shape.get_local_pose())
+    inv = world.inv()
+    o = inv.apply(origin)
+    d = inv.rotation.apply(direction)
+    big = 1.0e9
+    if isinstance(shape, physx.PhysxCollisionShapeBox):
+        h = np.asarray(shape.half_size, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t1 = (-h - o) / d
+            t2 = (h - o) / d
+        t1 = np.where(np.abs(d) < 1e-12, np.where(np.abs(o) <= h, -big, big), t1)
+        t2 = np.where(np.abs(d) < 1e-12, np.where(np.abs(o) <= h, big, -big), t2)
+        return float(max(0.0, np.min(np.maximum(t1, t2))))
+    if isinstance(shape, physx.PhysxCollisionShapeSphere):
+        r = float(shape.radius)
+        b = float(np.dot(o, d))
+        c = float(np.dot(o, o)) - r * r
+        disc = b * b - c
+        return float(max(0.0, -b + math.sqrt(disc))) if disc > 0 else 0.0
+    if isinstance(shape, (physx.PhysxCollisionShapeCylinder, physx.PhysxCollisionShapeCapsule)):
+        r, hl = float(shape.radius), float(shape.half_length)
+        if isinstance(shape, physx.PhysxCollisionShapeCapsule):
+            hl += r
+        # axis x: slab in x, circle in y-z
+        tx = big if abs(d[0]) < 1e-12 else max((-hl - o[0]) / d[0], (hl - o[0]) / d[0])
+        a = d[1] ** 2 + d[2] ** 2
+        if a < 1e-12:
+            tr = big
+        else:
+            b = o[1] * d[1] + o[2] * d[2]
+            c = o[1] ** 2 + o[2] ** 2 - r * r
+            disc = b * b - a * c
+            tr = (-b + math.sqrt(disc)) / a if disc > 0 else 0.0
+        return float(max(0.0, min(tx, tr)))
+    if isinstance(shape, physx.PhysxCollisionShapeConvexMesh):
+        v = np.asarray(shape.vertices, dtype=float) * np.asarray(shape.scale, dtype=float)
+        from scipy.spatial import ConvexHull
+
+        eq = ConvexHull(v).equations  # n.x + off <= 0 inside
+        nd = eq[:, :3] @ d
+        no = eq[:, :3] @ o + eq[:, 3]
+        with np.errstate(divide="ignore"):
+            t = np.where(nd > 1e-12, -no / nd, big)
+        return float(max(0.0, np.min(t)))
+    return 0.0

@@ -1,0 +1,434 @@
+"""Conformance suite: every registered backend must pass it.
+
+Backends come from the plugin manager, so a third-party backend installed
+through the ``benchharness`` entry-point group is tested too. Each test checks
+an analytic answer or a stated bound.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from benchharness.backends import (
+    Backend,
+    BackendError,
+    Box,
+    CameraSpec,
+    CapabilityError,
+    Cylinder,
+    MeshShape,
+    SimulationError,
+    Sphere,
+)
+from benchharness.geometry import Pose
+
+from backend_scenes import (
+    ARM_URDF,
+    CUBE_HALF,
+    CUBE_MASS,
+    GRIPPER_URDF,
+    ROTOR_URDF,
+    ASSETS,
+    grasp_lift_hold,
+    gripper_scene,
+    trajectory_digest,
+)
+
+G = 9.81
+
+
+# -- bodies and time ----------------------------------------------------------
+def test_free_fall_matches_analytic(backend: Backend):
+    """z(t) = z0 - g t^2 / 2. Semi-implicit Euler is off by g dt t / 2; allow g dt t."""
+    dt = backend.config.timestep
+    s = backend.add_body([Sphere(0.05)], Pose([0, 0, 10.0]), 1.0)
+    arm = backend.load_urdf(ARM_URDF, Pose([1.0, 0, 10.0]), fixed_base=False)
+    for _ in range(4):
+        backend.step(30)
+        t = backend.time
+        z = 10.0 - 0.5 * G * t * t
+        tol = G * dt * t + 1e-6
+        assert abs(backend.get_pose(s).p[2] - z) <= tol
+        assert abs(backend.get_pose(arm).p[2] - z) <= tol  # a free-base articulation falls alike
+        lin, ang = backend.get_velocity(s)
+        assert lin[2] == pytest.approx(-G * t, rel=1e-3)
+        assert np.allclose(lin[:2], 0, atol=1e-9) and np.allclose(ang, 0, atol=1e-9)
+    assert backend.time == pytest.approx(120 * dt)
+
+
+def test_pose_velocity_roundtrip(backend: Backend):
+    b = backend.add_body([Box((0.1, 0.05, 0.02)), Sphere(0.03, Pose([0.1, 0, 0]))], Pose(), 2.0)
+    pose = Pose([0.3, -0.2, 1.5], Rotation.from_euler("xyz", [0.3, -0.2, 1.0]).as_quat())
+    backend.set_velocity(b, [0.1, 0.2, 0.3], [0.5, -0.4, 0.2])
+    backend.set_pose(b, pose)  # keeps velocity
+    assert backend.get_pose(b).allclose(pose, atol_p=1e-6, atol_q=1e-6)
+    lin, ang = backend.get_velocity(b)
+    assert np.allclose(lin, [0.1, 0.2, 0.3], atol=1e-6) and np.allclose(ang, [0.5, -0.4, 0.2], atol=1e-6)
+    assert backend.get_mass(b) == pytest.approx(2.0)
+
+
+def test_shapes_rest_at_their_height(backend: Backend):
+    """Each primitive, resting on the ground, has its lowest point at z = 0 (within 1 mm)."""
+    backend.add_ground()
+    verts = np.array([[x, y, z] for x in (-0.03, 0.03) for y in (-0.02, 0.02) for z in (-0.01, 0.01)])
+    faces = np.array([[0, 1, 2]])
+    cases = [
+        (Box((0.03, 0.02, 0.01)), 0.01),
+        (Sphere(0.025), 0.025),
+        (Cylinder(0.02, 0.04), 0.04),  # axis along local z: stands on its end
+        (MeshShape(verts, faces), 0.01),
+    ]
+    bodies = []
+    for i, (shape, h) in enumerate(cases):
+        if isinstance(shape, MeshShape) and not backend.capabilities.mesh_collision:
+            continue
+        bodies.append((backend.add_body([shape], Pose([0.2 * i, 0, h + 0.002]), 0.1), h))
+    backend.step(120)
+    for b, h in bodies:
+        assert backend.get_pose(b).p[2] == pytest.approx(h, abs=1e-3)
+
+
+def test_compound_body(backend: Backend):
+    """A box with a convex-mesh foot rests on the foot; uniform density puts the COM between them."""
+    backend.add_ground()
+    foot = np.array([[x, y, z] for x in (-0.02, 0.02) for y in (-0.02, 0.02) for z in (-0.01, 0.01)])
+    shapes = [Box((0.05, 0.05, 0.05)), MeshShape(foot, np.zeros((0, 3), dtype=int), Pose([0, 0, -0.06]))]
+    if not backend.capabilities.mesh_collision:
+        shapes = shapes[:1]
+    b = backend.add_body(shapes, Pose([0, 0, 0.072]), 1.0)
+    backend.step(240)
+    assert backend.get_pose(b).p[2] == pytest.approx(0.07 if len(shapes) == 2 else 0.05, abs=1e-3)
+    assert backend.get_pose(b).rotation.magnitude() < 1e-2
+
+
+def test_box_resting_contacts(backend: Backend):
+    """Normal from B (ground) to A (box) is +z; the normal forces add up to m g within 3%."""
+    g = backend.add_ground()
+    m = 0.5
+    box = backend.add_body([Box((0.05, 0.04, 0.03))], Pose([0, 0, 0.03]), m)
+    backend.step(120)
+    cs = backend.contacts(box, g)
+    assert cs, "a resting box must report contacts"
+    for c in cs:
+        assert (c.body_a, c.body_b, c.link_a, c.link_b) == (box, g, None, None)
+        assert c.normal @ [0, 0, 1] > 0.99
+        assert c.normal_force >= 0
+        assert abs(c.position[2]) < 2e-3 and abs(c.distance) < 2e-3
+    assert sum(c.normal_force for c in cs) == pytest.approx(m * G, rel=0.03)
+    flipped = backend.contacts(g, box)
+    assert flipped and all(c.body_a == g and c.normal @ [0, 0, 1] < -0.99 for c in flipped)
+    assert sum(c.normal_force for c in backend.contacts(body_b=g)) == pytest.approx(m * G, rel=0.03)
+    assert all(c.body_b == g for c in backend.contacts(body_b=g))
+
+
+# -- URDF, joints, drives ---------------------------------------------------------
+def test_urdf_joint_and_link_info(backend: Backend):
+    arm = backend.load_urdf(ARM_URDF, Pose([0.5, 0, 0]))
+    info = backend.joint_info(arm)
+    assert [j.name for j in info] == ["yaw", "pitch"] == backend.joint_names(arm)
+    assert (info[0].lower, info[0].upper, info[0].max_effort, info[0].max_velocity) == (-3.0, 3.0, 50.0, 3.0)
+    assert (info[1].parent_link, info[1].child_link, info[1].type) == ("upper", "fore", "revolute")
+    assert backend.link_names(arm) == ["base", "upper", "fore", "tip"]
+    assert backend.get_mass(arm) == pytest.approx(2.85)
+    rot = backend.load_urdf(ROTOR_URDF, Pose())
+    j = backend.joint_info(rot)[0]
+    assert j.type == "continuous" and j.lower == -math.inf and j.upper == math.inf
+    with pytest.raises(BackendError):
+        backend.get_link_pose(arm, "no_such_link")
+
+
+def test_link_poses_match_forward_kinematics(backend: Backend):
+    base = Pose([0.5, -0.2, 0.1], Rotation.from_euler("z", 0.4).as_quat())
+    arm = backend.load_urdf(ARM_URDF, base)
+    q = np.array([0.7, -0.5])
+    backend.set_joint_positions(arm, q)
+    st = backend.get_joint_state(arm)
+    assert np.allclose(st.positions, q, atol=1e-6) and np.allclose(st.velocities, 0, atol=1e-9)
+    up = base * Pose([0, 0, 0.1], Rotation.from_euler("z", q[0]).as_quat())
+    fore = up * Pose([0, 0, 0.2], Rotation.from_euler("y", q[1]).as_quat())
+    tip = fore * Pose([0.2, 0, 0], Rotation.from_euler("y", math.pi / 2).as_quat())
+    for name, want in (("base", base), (None, base), ("upper", up), ("fore", fore), ("tip", tip)):
+        assert backend.get_link_pose(arm, name).allclose(want, atol_p=1e-5, atol_q=1e-5), name
+    backend.set_joint_positions(arm, [0.1], joints=["pitch"])
+    assert backend.get_joint_state(arm).positions == pytest.approx([0.7, 0.1], abs=1e-6)
+
+
+def test_pd_gains_are_physical(backend: Backend):
+    """A 1-DOF rotor (I = 0.01 kg m^2), k = 1, d = 0.1: a damped oscillator, omega 10 rad/s, zeta 0.5.
+
+    Bound: 0.01 rad (2% of the 0.5 rad step) from the analytic response over 1 s.
+    """
+    rot = backend.load_urdf(ROTOR_URDF, Pose())
+    backend.set_joint_targets(rot, [0.5], stiffness=1.0, damping=0.1)
+    w, z = 10.0, 0.5
+    wd = w * math.sqrt(1 - z * z)
+    worst = 0.0
+    for _ in range(int(1.0 / backend.config.timestep)):
+        backend.step()
+        t = backend.time
+        qa = 0.5 * (1 - math.exp(-z * w * t) * (math.cos(wd * t) + z / math.sqrt(1 - z * z) * math.sin(wd * t)))
+        worst = max(worst, abs(backend.get_joint_state(rot).positions[0] - qa))
+    assert worst < 0.01
+
+
+def test_velocity_drive(backend: Backend):
+    """A pure velocity drive (no position target) spins the free rotor up to v* (tau = I/d = 10 ms)."""
+    rot = backend.load_urdf(ROTOR_URDF, Pose())
+    backend.set_joint_targets(rot, velocities=[2.0], damping=1.0)
+    backend.step(120)
+    st = backend.get_joint_state(rot)
+    assert st.velocities[0] == pytest.approx(2.0, rel=0.01)
+    assert st.positions[0] == pytest.approx(2.0 * (0.5 - 0.01), abs=0.02)  # lags the ramp by tau
+    with pytest.raises(BackendError):
+        backend.set_joint_targets(rot, [0.0], joints=["no_such_joint"])
+
+
+def test_joint_tracking(backend: Backend):
+    """The 2-DOF arm follows a 1 s ramp within 0.05 rad and settles within 0.01 rad, in gravity."""
+    arm = backend.load_urdf(ARM_URDF, Pose())
+    goal = np.array([1.0, -0.6])
+    n = int(1.0 / backend.config.timestep)
+    worst = 0.0
+    for i in range(n):
+        target = goal * (i + 1) / n
+        backend.set_joint_targets(arm, target, stiffness=200.0, damping=10.0)
+        backend.step()
+        worst = max(worst, float(np.max(np.abs(backend.get_joint_state(arm).positions - target))))
+    backend.step(n // 2)
+    st = backend.get_joint_state(arm)
+    assert worst < 0.05
+    assert np.allclose(st.positions, goal, atol=0.01)
+    assert np.all(np.abs(st.efforts) <= 50.0 + 1e-6)
+
+
+def test_free_base_articulation_drives(backend: Backend):
+    """The arm standing free on the ground reaches its joint targets (within 0.01 rad in 1 s)."""
+    backend.add_ground()
+    arm = backend.load_urdf(ARM_URDF, Pose(), fixed_base=False)
+    backend.set_joint_targets(arm, [0.5, -0.5], stiffness=200.0, damping=10.0)
+    backend.step(240)
+    assert backend.get_joint_state(arm).positions == pytest.approx([0.5, -0.5], abs=0.01)
+    assert abs(backend.get_pose(arm).p[2]) < 0.01  # still standing on its base
+
+
+def test_force_limit_caps_the_drive(backend: Backend):
+    """A drive capped below the gravity torque (0.39 N m) cannot hold the forearm up."""
+    arm = backend.load_urdf(ARM_URDF, Pose())
+    backend.set_joint_targets(arm, [0.0, 0.0], stiffness=1000.0, damping=10.0, force_limit=[50.0, 0.2])
+    backend.step(120)
+    assert backend.get_joint_state(arm).positions[1] > 0.3  # pitch about +y: the tip drops
+
+
+def test_joint_friction(backend: Backend):
+    """Coulomb friction above the gravity torque (0.39 N m) holds the forearm; below it, it falls."""
+    for torque, falls in ((0.6, False), (0.2, True)):
+        b = backend
+        arm = b.load_urdf(ARM_URDF, Pose([2.0 * torque, 0, 0]))
+        b.set_joint_friction(arm, [5.0, torque])
+        b.step(120)
+        q = b.get_joint_state(arm).positions
+        assert abs(q[0]) < 1e-3
+        if falls:
+            assert q[1] > 0.3
+        else:
+            assert abs(q[1]) < 0.01
+    # a joint with a position target keeps it when friction is set
+    arm = backend.load_urdf(ARM_URDF, Pose([-1.0, 0, 0]))
+    backend.set_joint_targets(arm, [0.5, 0.0], stiffness=200.0, damping=10.0)
+    backend.set_joint_friction(arm, 0.05)
+    backend.step(240)
+    assert backend.get_joint_state(arm).positions == pytest.approx([0.5, 0.0], abs=0.01)
+
+
+def test_self_collision_filtering(backend: Backend):
+    """Links adjacent through a fixed link do not collide; other link pairs do."""
+    body = backend.load_urdf(ASSETS / "filtered.urdf", Pose())
+    backend.set_joint_targets(body, [0.5], stiffness=10.0, damping=1.0)
+    backend.step(120)
+    assert backend.get_joint_state(body).positions[0] == pytest.approx(0.5, abs=0.01)
+    assert not [c for c in backend.contacts(body, body) if c.normal_force > 0]
+    # the gripper's pads (siblings' children) do collide: closing fully stops the fingers at q = 9 mm
+    grip = backend.load_urdf(GRIPPER_URDF, Pose([1.0, 0, 0]))
+    backend.set_joint_positions(grip, [0.3, 0.03, 0.03])
+    backend.set_joint_targets(grip, [0.3, 0.0, 0.0], stiffness=[20000.0, 2000.0, 2000.0], damping=[1000.0, 40.0, 40.0])
+    backend.step(120)
+    q = backend.get_joint_state(grip).positions
+    assert q[1:] == pytest.approx([0.009, 0.009], abs=1e-3)
+    pads = {frozenset((c.link_a, c.link_b)) for c in backend.contacts(grip, grip) if c.normal_force > 0}
+    assert frozenset(("pad_l", "pad_r")) in pads
+
+
+# -- ray casts -------------------------------------------------------------------
+def test_ray_cast(backend: Backend):
+    g = backend.add_ground()
+    box = backend.add_body([Box((0.05, 0.05, 0.05))], Pose([0.3, 0.1, 0.2]), 1.0, fixed=True)
+    xy = np.array([[0.3, 0.1], [0.27, 0.13], [0.34, 0.06]])
+    o = np.column_stack([xy, np.full(3, 1.0)])
+    d = np.tile([0.0, 0.0, -1.0], (3, 1))
+    r = backend.ray_cast(o, d, 2.0)
+    assert r.hit.all() and (r.body == box).all()
+    assert np.allclose(r.distance, 0.75, atol=1e-3)  # top face at z = 0.25
+    assert np.allclose(r.point[:, 2], 0.25, atol=1e-3)
+    assert np.allclose(r.normal, [0, 0, 1], atol=1e-3)
+    # sideways onto the -x face at x = 0.25
+    r = backend.ray_cast(np.array([[0.0, 0.1, 0.2]]), np.array([[1.0, 0, 0]]), 1.0)
+    assert r.hit[0] and r.distance[0] == pytest.approx(0.25, abs=1e-3)
+    # misses: nothing there, and too short
+    r = backend.ray_cast(np.array([[5.0, 5.0, 1.0], [0.3, 0.1, 1.0]]), np.array([[0, 0, 1.0], [0, 0, -1.0]]), [2.0, 0.5])
+    assert not r.hit.any() and np.isinf(r.distance).all() and np.isnan(r.point).all()
+    assert np.isnan(r.normal).all() and (r.body == -1).all()
+    # ignore_bodies: through the box to the ground
+    r = backend.ray_cast(o, d, 2.0, ignore_bodies=[box])
+    assert r.hit.all() and (r.body == g).all() and np.allclose(r.distance, 1.0, atol=1e-3)
+    r = backend.ray_cast(o, d, 2.0, ignore_bodies=[box, g])
+    assert not r.hit.any()
+
+
+# -- grasping --------------------------------------------------------------------
+def test_gripper_grasp_lift_hold(backend: Backend):
+    """Grip 20 N per finger (2000 N/m x 1 cm), lift 10 cm in 1 s, hold 5 s: slip < 5 mm."""
+    s = gripper_scene(backend)
+    r = grasp_lift_hold(s, hold_s=5.0, lift=0.10)
+    assert r["cube_z"] == pytest.approx(CUBE_HALF + 0.10, abs=0.005)
+    assert np.linalg.norm(r["end_rel"] - r["grasp_rel"]) < 0.005
+    for f in r["pad_forces"].values():
+        assert f == pytest.approx(20.0, rel=0.05)
+    assert backend.get_mass(s.cube) == pytest.approx(CUBE_MASS)
+    # links joined through fixed links (pads, palm, carriage) never touch each other
+    assert not [c for c in backend.contacts(s.gripper, s.gripper) if c.normal_force > 0]
+
+
+def test_attach_detach(backend: Backend):
+    """An attached box stays put (< 1 mm in 1 s) at the requested relative pose; detached, it falls."""
+    backend.add_ground()
+    post = backend.add_body([Box((0.02, 0.02, 0.25))], Pose([0, 0, 0.25]), 1.0, fixed=True)
+    box = backend.add_body([Box((0.03, 0.03, 0.03))], Pose([0.1, 0, 0.4]), 0.2)
+    rel = Pose([0.1, 0, 0.15])
+    c = backend.attach(post, None, box, None, rel)
+    backend.step(240)
+    assert np.linalg.norm(backend.get_pose(box).p - [0.1, 0, 0.4]) < 1e-3
+    backend.detach(c)
+    backend.step(60)
+    assert backend.get_pose(box).p[2] < 0.4 - 0.05
+    with pytest.raises(BackendError):
+        backend.detach(c)
+    # attach to a URDF link (the gripper's palm) and move the link
+    grip = backend.load_urdf(GRIPPER_URDF, Pose([1.0, 0, 0]))
+    backend.set_joint_positions(grip, [0.3, 0.06, 0.06])
+    backend.set_joint_targets(grip, [0.3, 0.06, 0.06], stiffness=20000.0, damping=1000.0)
+    ball = backend.add_body([Sphere(0.02)], Pose([1.0, 0, 0.25]), 0.1)
+    backend.attach(grip, "palm", ball, None, Pose([0, 0, -0.05]))
+    backend.step(120)
+    assert np.linalg.norm(backend.get_pose(ball).p - [1.0, 0, 0.25]) < 2e-3
+
+
+def test_remove_and_replace_without_jump(backend: Backend):
+    """Swap a resting cube for an identical body in place: it moves < 0.5 mm in the next 0.5 s."""
+    backend.add_ground()
+    cube = backend.add_body([Box((CUBE_HALF,) * 3)], Pose([0, 0, CUBE_HALF]), CUBE_MASS)
+    backend.step(120)
+    pose = backend.get_pose(cube)
+    lin, ang = backend.get_velocity(cube)
+    backend.remove_body(cube)
+    with pytest.raises(BackendError):
+        backend.get_pose(cube)
+    slabs = [Box((CUBE_HALF, CUBE_HALF, CUBE_HALF / 3), Pose([0, 0, dz])) for dz in (-2 * CUBE_HALF / 3, 0.0, 2 * CUBE_HALF / 3)]
+    new = backend.add_body(slabs, pose, CUBE_MASS)
+    backend.set_velocity(new, lin, ang)
+    backend.step(120)
+    assert np.linalg.norm(backend.get_pose(new).p - pose.p) < 5e-4
+    assert new != cube  # handles are never reused
+    # articulations can be removed too, with their attachments
+    grip = backend.load_urdf(GRIPPER_URDF, Pose([1.0, 0, 0.5]))
+    ball = backend.add_body([Sphere(0.02)], Pose([1.0, 0, 0.45]), 0.1)
+    c = backend.attach(grip, "palm", ball, None, Pose([0, 0, -0.05]))
+    backend.remove_body(grip)
+    with pytest.raises(BackendError):
+        backend.detach(c)
+    backend.step(12)
+    assert backend.get_pose(ball).p[2] == pytest.approx(0.45 - 0.5 * G * (12 * backend.config.timestep) ** 2, abs=2e-3)
+
+
+# -- robustness --------------------------------------------------------------------
+def test_determinism_in_process(item):
+    assert trajectory_digest(item.name, 0.3) == trajectory_digest(item.name, 0.3)
+
+
+def test_determinism_across_processes(item):
+    here = Path(__file__).resolve().parent
+    code = (
+        f"import sys; sys.path.insert(0, {str(here)!r}); from backend_scenes import trajectory_digest; "
+        f"print(trajectory_digest({item.name!r}, 0.3))"
+    )
+    procs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    here_digest = trajectory_digest(item.name, 0.3)
+    outs = []
+    for p in procs:
+        out, _ = p.communicate(timeout=120)
+        assert p.returncode == 0
+        outs.append(out.split()[-1])
+    assert outs[0] == outs[1] == here_digest
+
+
+def test_blowup_raises_simulation_error(backend: Backend):
+    backend.add_ground()
+    b = backend.add_body([Box((0.05, 0.05, 0.05))], Pose([0, 0, 0.05]), 1.0, name="victim")
+    backend.step(2)
+    backend.set_velocity(b, [float("nan"), 0, 0], [0, 0, 0])  # (Bullet clamps huge speeds to 100)
+    with pytest.raises(SimulationError, match="victim"):
+        backend.step(10)
+    with pytest.raises(SimulationError):
+        backend.check_finite([b])
+
+
+def test_blowup_in_joints_raises(backend: Backend):
+    arm = backend.load_urdf(ARM_URDF, Pose(), name="arm")
+    backend.set_joint_positions(arm, [float("nan"), 0.0])
+    with pytest.raises(SimulationError, match="arm"):
+        backend.step(5)
+
+
+def test_capabilities(backend: Backend, item):
+    caps = backend.capabilities
+    meta = item.meta.get("capabilities")
+    if meta is not None:  # a registration that states capabilities must tell the truth
+        assert meta == {k: getattr(caps, k) for k in meta}
+    cam = CameraSpec(eye=(0.5, 0.5, 0.5), target=(0, 0, 0), width=64, height=48)
+    if caps.camera:
+        backend.add_ground()
+        backend.add_body([Box((0.05, 0.05, 0.05))], Pose([0, 0, 0.05]), 1.0)
+        img = backend.render(cam)
+        assert img.shape == (48, 64, 3) and img.dtype == np.uint8
+        assert img.std() > 1.0  # not a blank frame
+    else:
+        with pytest.raises(CapabilityError):
+            backend.render(cam)
+
+
+def test_worlds_are_independent(make):
+    a, b = make(), make(gravity=(0.0, 0.0, 0.0))
+    ba = a.add_body([Sphere(0.05)], Pose([0, 0, 1.0]), 1.0)
+    bb = b.add_body([Sphere(0.05)], Pose([0, 0, 1.0]), 1.0)
+    a.step(60)
+    b.step(60)
+    assert a.get_pose(ba).p[2] < 0.9 and b.get_pose(bb).p[2] == pytest.approx(1.0)
+    a.close()
+    a.close()  # safe twice
+    b.step(1)
+
+
+@pytest.mark.slow
+def test_gripper_long_hold(backend: Backend):
+    """The same grasp held for 60 s: slip < 5 mm, grip within 5% of 20 N (run with -m slow)."""
+    s = gripper_scene(backend)
+    r = grasp_lift_hold(s, hold_s=60.0, lift=0.10)
+    assert np.linalg.norm(r["end_rel"] - r["grasp_rel"]) < 0.005
+    for f in r["pad_forces"].values():
+        assert f == pytest.approx(20.0, rel=0.05)
