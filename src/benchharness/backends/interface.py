@@ -82,7 +82,10 @@ class PhysicsConfig:
 
     timestep: float = 1.0 / 240.0  #: seconds per :meth:`Backend.step`
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    solver_iterations: int = 50  #: PyBullet needs >= 50 at 1/240 s for accurate twists
+    #: Solver (position) iterations per step; ``None`` = the engine's validated
+    #: default (:attr:`Backend.default_solver_iterations`: PyBullet 50, which it
+    #: needs at 1/240 s for accurate twists; SAPIEN/PhysX TGS 20).
+    solver_iterations: int | None = None
     solver_velocity_iterations: int = 1
     contact_offset: float = 0.002  #: SAPIEN/PhysX contact offset (m); 1 cm default is too large here
     default_friction: float = 1.0
@@ -183,9 +186,16 @@ class Backend(abc.ABC):
 
     name: ClassVar[str]
     capabilities: ClassVar[Capabilities]
+    default_solver_iterations: ClassVar[int] = 50
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
         self.config = config or PhysicsConfig()
+
+    @property
+    def solver_iterations(self) -> int:
+        """The solver iterations in force: the config's, or this engine's default."""
+        n = self.config.solver_iterations
+        return self.default_solver_iterations if n is None else int(n)
 
     # -- lifetime ------------------------------------------------------------
     @abc.abstractmethod

@@ -119,6 +119,7 @@ def _as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:
 class SapienBackend(Backend):
     name = "sapien"
     capabilities = Capabilities(camera=False, mesh_collision=True, joint_friction=True, mimic_joints=False)
+    default_solver_iterations = 20  # DESIGN.md spike: TGS with 20 position iterations twists the cube correctly
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
         super().__init__(config)
@@ -143,7 +144,7 @@ class SapienBackend(Backend):
         c = self.config
         physx.set_shape_config(contact_offset=float(c.contact_offset), rest_offset=0.0)
         physx.set_body_config(
-            solver_position_iterations=int(c.solver_iterations),
+            solver_position_iterations=self.solver_iterations,
             solver_velocity_iterations=int(c.solver_velocity_iterations),
             sleep_threshold=0.0,  # no sleeping: Bullet multibodies do not sleep either
         )
