@@ -1,0 +1,1 @@
+"""Built-in sensors and pose estimators (filled in as they land)."""
