@@ -100,9 +100,29 @@ class UnknownTierError(LookupError):
 
 
 def get_tier(name: str) -> RubiksTier:
-    """Look a tier up by name (case-insensitive); :class:`UnknownTierError` lists the valid names."""
+    """Look a tier up by name (case-insensitive); :class:`UnknownTierError` lists the valid names.
+
+    The paper's twelve tiers come from ``tasks/rubiks/tiers.toml``; a tier
+    that a third-party plugin registers as a task (a factory returning a
+    :class:`RubiksTier`) is found through the plugin manager, so the protocol
+    CLI serves plugin tiers too.
+    """
     tiers = load_tiers()
+    wanted = name.strip().lower()
     for tier_name, tier in tiers.items():
-        if tier_name.lower() == name.strip().lower():
+        if tier_name.lower() == wanted:
             return tier
-    raise UnknownTierError(f"unknown tier {name!r}; tiers are {', '.join(tiers)}")
+    from ..plugin import get_manager  # deferred: the built-in tier plugin imports this module
+
+    plugin_tiers = []
+    for item in get_manager().items("task"):
+        if item.name in tiers:
+            continue
+        if item.name.lower() == wanted:
+            obj = item.create()
+            if isinstance(obj, RubiksTier):
+                return obj
+        elif item.meta.get("benchmark") == "rubiks":
+            plugin_tiers.append(item.name)
+    known = ", ".join(list(tiers) + plugin_tiers)
+    raise UnknownTierError(f"unknown tier {name!r}; tiers are {known}")
