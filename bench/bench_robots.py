@@ -1,0 +1,137 @@
+"""Robot performance figures (not unit tests): physics steps/s, real-time factor, batched IK.
+
+Scene: the PR2 (both arms and grippers holding their targets) over a table
+with a 5.7 cm, 94 g cube, on each backend, at the default PhysicsConfig.
+Three loops per backend:
+
+* ``physics``   — ``backend.step(n)`` with the PD targets set once (the
+  engine plus the backend's own per-step work);
+* ``control``   — ``robot.settle()``: the robot's Python control loop (hold
+  targets + gravity feed-forward every 1/120 s) on top;
+* ``physics@10it`` — ``physics`` with 10 solver iterations instead of 50,
+  to show what the solver costs.
+
+Then IK: 1,000 random reachable targets for one PR2 arm, batched.
+
+Usage::
+
+    python bench/bench_robots.py [--seconds 3] [--json out.json]
+
+Torch is limited to one thread and the figures are per core (the process
+runs single-threaded; other load on the machine shows up in the numbers).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from dataclasses import replace
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+
+torch.set_num_threads(1)
+
+from benchharness.backends.interface import Box, PhysicsConfig  # noqa: E402
+from benchharness.geometry import Pose  # noqa: E402
+from benchharness.plugin import get_manager  # noqa: E402
+
+CUBE_HALF, CUBE_MASS = 0.0285, 0.094
+
+
+def build_scene(backend_name: str, config: PhysicsConfig):
+    m = get_manager()
+    be = m.create("backend", backend_name, config=config)
+    be.add_ground()
+    robot = m.create("robot", "pr2")
+    robot.spawn(be)
+    tcp = robot.arm("left_arm").tcp_pose()
+    top = tcp.p[2] - CUBE_HALF
+    be.add_body([Box((0.25, 0.4, top / 2))], Pose([0.95, 0.0, top / 2]), 20.0, fixed=True, name="table")
+    cube = be.add_body([Box((CUBE_HALF,) * 3)], Pose([0.85, 0.0, top + CUBE_HALF + 5e-4]), CUBE_MASS,
+                       friction=1.0, name="cube")
+    robot.settle(0.2)
+    return be, robot, cube
+
+
+def time_loop(fn, sim_seconds: float, dt: float) -> dict:
+    t0 = time.perf_counter()
+    steps = fn(sim_seconds)
+    wall = time.perf_counter() - t0
+    return {"steps": steps, "wall_s": wall, "steps_per_s": steps / wall, "real_time_factor": steps * dt / wall}
+
+
+def bench_backend(name: str, seconds: float) -> dict:
+    out = {}
+    for label, cfg in (("physics", PhysicsConfig()), ("physics@10it", replace(PhysicsConfig(), solver_iterations=10))):
+        be, robot, cube = build_scene(name, cfg)
+        dt = cfg.timestep
+
+        def physics(sim_s, be=be, dt=dt):
+            n = int(round(sim_s / dt))
+            be.step(n)
+            return n
+
+        out[label] = time_loop(physics, seconds, dt)
+        if label == "physics":
+            out[label]["cube_speed_m_s"] = float(np.linalg.norm(be.get_velocity(cube)[0]))  # at rest: ~0
+
+            def control(sim_s, robot=robot, dt=dt):
+                robot.settle(sim_s)
+                return int(round(sim_s / dt))
+
+            out["control"] = time_loop(control, seconds, dt)
+        be.close()
+    return out
+
+
+def bench_ik(n: int = 1000) -> dict:
+    robot = get_manager().create("robot", "pr2")
+    arm = robot.arm("left_arm")
+    q = arm.chain.sample(n, torch.Generator().manual_seed(0))
+    targets = arm.fk(q)
+    arm.ik(targets[:10], seed=1)  # warm-up
+    t0 = time.perf_counter()
+    res = arm.ik(targets, seed=1)
+    wall = time.perf_counter() - t0
+    ok = (res.pos_error <= 1e-3) & (res.rot_error <= np.radians(1.0))
+    return {"targets": n, "wall_s": wall, "ms_per_target": 1e3 * wall / n,
+            "converged_0.1mm": float(res.success.mean()), "within_1mm_1deg": float(ok.mean())}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=3.0, help="simulated seconds per loop")
+    ap.add_argument("--json", default=None, help="also write the figures here")
+    ap.add_argument("--backends", default="pybullet,sapien")
+    args = ap.parse_args()
+    results = {"machine": {"cpu_count": os.cpu_count(), "python": platform.python_version(),
+                           "load_avg_1min": os.getloadavg()[0]},
+               "timestep": PhysicsConfig().timestep, "backends": {}}
+    for b in args.backends.split(","):
+        results["backends"][b] = bench_backend(b, args.seconds)
+    results["ik"] = bench_ik()
+    results["machine"]["load_avg_after"] = os.getloadavg()[0]
+    print(f"{'loop':14s} " + " ".join(f"{b + ' steps/s':>16s} {b + ' RTF':>12s}" for b in results["backends"]))
+    for loop in ("physics", "control", "physics@10it"):
+        row = []
+        for b, r in results["backends"].items():
+            row.append(f"{r[loop]['steps_per_s']:16.0f} {r[loop]['real_time_factor']:12.2f}")
+        print(f"{loop:14s} " + " ".join(row))
+    ik = results["ik"]
+    print(f"IK: {ik['targets']} targets in {ik['wall_s']:.2f} s ({ik['ms_per_target']:.2f} ms each), "
+          f"{ik['within_1mm_1deg']:.1%} within 1 mm / 1 deg")
+    print(f"load average {results['machine']['load_avg_1min']:.2f} -> {results['machine']['load_avg_after']:.2f} "
+          f"on {results['machine']['cpu_count']} CPUs")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(results, fh, indent=2)
+
+
+if __name__ == "__main__":
+    main()

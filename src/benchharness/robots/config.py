@@ -1,0 +1,149 @@
+"""Typed configurations of robots and their parts (arms, grippers/hands).
+
+A robot is described by data, not by subclassing: a :class:`RobotConfig`
+names the URDF, the arms (serial chains ending in a tool frame), the
+grippers or hands (actuated joint sets with a coupling), extra joint groups
+and a home configuration. The shipped robots (``pr2``, ``herb``, ``allegro``)
+are functions returning such configs; a user's own robot is another one.
+
+All names (joints, links) are those of the URDF in use. :meth:`RobotConfig.remapped`
+renames them when a user points a robot at a full-fidelity URDF whose names
+differ from ours.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Literal, Mapping, Sequence
+
+import numpy as np
+
+from ..geometry import Pose
+
+__all__ = ["ArmConfig", "GripperConfig", "RobotConfig", "gains_from_effort"]
+
+
+@dataclass(frozen=True)
+class ArmConfig:
+    """A serial chain from ``base_link`` to a tool frame ``tcp_link``: an arm, or one finger."""
+
+    name: str  #: group name, e.g. ``"left_arm"``, ``"index"``
+    joints: tuple[str, ...]  #: movable joints from base to tip (the chain's order)
+    base_link: str  #: IK targets are expressed in this link's frame (converted from world by the robot)
+    tcp_link: str  #: tool-centre-point frame (a URDF link)
+    stiffness: tuple[float, ...]  #: PD stiffness per joint (N m/rad or N/m)
+    damping: tuple[float, ...]  #: PD damping per joint (N m s/rad or N s/m)
+    position_only: bool = False  #: IK on position only (fingers with < 6 DOF)
+    velocity_scale: float = 0.5  #: trajectories use this fraction of each joint's URDF velocity limit
+    gravity_carried: bool = False  #: gravity torque is carried by a counterbalance, not by the motors (PR2)
+
+
+@dataclass(frozen=True)
+class GripperConfig:
+    """An actuated grasping joint set (parallel gripper, BarrettHand, Allegro hand).
+
+    The physical joints follow a few actuator commands through a linear
+    coupling, ``q_joint = coupling @ u`` — this is how fingers that a real
+    hand couples mechanically (mimic joints) are driven, since PhysX has no
+    mimic joints. Each joint is an independent PD drive towards its coupled
+    target, capped at ``force_limit``: a blocked proximal link does not stop
+    its distal link, much like the BarrettHand's breakaway clutch.
+    """
+
+    name: str  #: group name, e.g. ``"left_gripper"``
+    joints: tuple[str, ...]  #: physical joints
+    actuators: tuple[str, ...]  #: command names, e.g. ``("grip",)``, ``("spread", "f1", "f2", "f3")``
+    coupling: tuple[tuple[float, ...], ...]  #: (len(joints), len(actuators)) matrix
+    open: tuple[float, ...]  #: actuator values of the open hand
+    closed: tuple[float, ...]  #: actuator values of the fully closed hand (no object)
+    grasp_actuators: tuple[str, ...]  #: actuators that close() moves (others keep their value, e.g. spread)
+    stiffness: tuple[float, ...]  #: per joint
+    damping: tuple[float, ...]  #: per joint
+    force_limit: tuple[float, ...]  #: default per-joint force/torque cap for closing (N or N m)
+    finger_links: tuple[str, ...]  #: links whose contacts count as the hand touching an object
+    tcp_link: str | None = None  #: grasp-centre frame, if the hand has one
+    kind: Literal["parallel", "multifinger"] = "parallel"
+    #: (follower joint, leader joint, ratio): the follower tracks ``ratio * measured leader`` while the
+    #: leader moves, and its own coupled target once the leader stalls (the BarrettHand's breakaway).
+    follow: tuple[tuple[str, str, float], ...] = ()
+
+    def joint_targets(self, u: Sequence[float]) -> np.ndarray:
+        return np.asarray(self.coupling, dtype=float) @ np.asarray(u, dtype=float)
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """A whole robot: description, parts, groups and home configuration."""
+
+    name: str
+    urdf: Path
+    arms: tuple[ArmConfig, ...] = ()
+    grippers: tuple[GripperConfig, ...] = ()
+    extra_groups: Mapping[str, tuple[str, ...]] = field(default_factory=dict)  #: e.g. ``{"torso": ("torso_lift_joint",)}``
+    extra_gains: Mapping[str, tuple[float, float]] = field(default_factory=dict)  #: joint -> (stiffness, damping) for joints outside arms/grippers
+    home: Mapping[str, float] = field(default_factory=dict)  #: joint -> position; unnamed joints home at 0 (clamped to limits)
+    base_pose: Pose = field(default_factory=Pose)  #: world pose of the URDF root link
+    fixed_base: bool = True
+    summary: str = ""
+    sources: tuple[str, ...] = ()  #: where the figures come from (README has the detail)
+
+    def groups(self) -> dict[str, tuple[str, ...]]:
+        g: dict[str, tuple[str, ...]] = {a.name: a.joints for a in self.arms}
+        g.update({h.name: h.joints for h in self.grippers})
+        g.update(dict(self.extra_groups))
+        return g
+
+    def remapped(
+        self,
+        urdf: str | Path,
+        joint_map: Mapping[str, str] | None = None,
+        link_map: Mapping[str, str] | None = None,
+    ) -> "RobotConfig":
+        """The same robot on another URDF whose joint/link names differ by the given maps.
+
+        Maps go from our names to the names in ``urdf``; names not in a map
+        are kept. Parts whose joints the maps name ``""`` are dropped — e.g.
+        a full PR2 URDF has one gripper joint with mimic fingers, which our
+        two-finger gripper part cannot drive.
+        """
+        jm = dict(joint_map or {})
+        lm = dict(link_map or {})
+
+        def j(n: str) -> str:
+            return jm.get(n, n)
+
+        def lk(n: str | None) -> str | None:
+            return None if n is None else lm.get(n, n)
+
+        arms = tuple(
+            replace(a, joints=tuple(j(n) for n in a.joints), base_link=lk(a.base_link), tcp_link=lk(a.tcp_link))
+            for a in self.arms
+            if all(j(n) for n in a.joints)
+        )
+        grippers = tuple(
+            replace(
+                h,
+                joints=tuple(j(n) for n in h.joints),
+                finger_links=tuple(lk(n) for n in h.finger_links),
+                tcp_link=lk(h.tcp_link),
+            )
+            for h in self.grippers
+            if all(j(n) for n in h.joints)
+        )
+        extra = {k: tuple(j(n) for n in v if j(n)) for k, v in self.extra_groups.items()}
+        gains = {j(k): v for k, v in self.extra_gains.items() if j(k)}
+        home = {j(k): v for k, v in self.home.items() if j(k)}
+        return replace(self, urdf=Path(urdf), arms=arms, grippers=grippers, extra_groups=extra,
+                       extra_gains=gains, home=home)
+
+
+def gains_from_effort(efforts: Sequence[float], kp_per_effort: float, kd_per_effort: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """PD gains proportional to each joint's effort limit.
+
+    Why: stiff joints where the motor is strong and soft where it is weak
+    keep the drive saturating at about the same position error on every
+    joint, instead of the wrist saturating long before the shoulder.
+    """
+    e = np.asarray(efforts, dtype=float)
+    return tuple((kp_per_effort * e).tolist()), tuple((kd_per_effort * e).tolist())

@@ -1,0 +1,33 @@
+"""Generators of the shipped collision-only URDFs (``robots/<name>/<name>.urdf``).
+
+The URDF files are generated, not hand-edited: the figures and their sources
+live in these modules, and ``python -m benchharness.robots.descriptions``
+rewrites the files. A test checks that the shipped files match.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from ..urdf_builder import UrdfModel
+
+__all__ = ["generators", "write_all"]
+
+
+def generators() -> dict[str, Callable[[], UrdfModel]]:
+    """Robot name -> function building its :class:`UrdfModel`."""
+    from . import allegro, herb, pr2
+
+    return {"pr2": pr2.build, "herb": herb.build, "allegro": allegro.build}
+
+
+def write_all(root: Path) -> list[Path]:
+    """Write ``<root>/<name>/<name>.urdf`` for every shipped robot."""
+    out = []
+    for name, build in generators().items():
+        path = root / name / f"{name}.urdf"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(build().to_xml())
+        out.append(path)
+    return out

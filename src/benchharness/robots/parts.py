@@ -1,0 +1,346 @@
+"""The composable parts of a robot: :class:`RobotArm` (a chain with a tool frame) and :class:`Gripper`.
+
+Parts hold kinematics and motion primitives; they act on the simulated
+robot only through the :class:`~benchharness.robots.robot.Robot` they belong
+to, which owns the backend handle. Every physical effect goes through the
+Backend interface: IK and trajectory timing are computed here, the motion
+itself is PD targets and backend steps.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Sequence
+
+import numpy as np
+import torch
+
+from ..backends.interface import BodyId
+from ..geometry import Pose
+from ..kinematics import IKConfig, IKResult, KinematicChain, pose_error
+from .config import ArmConfig, GripperConfig
+from .trajectory import QuinticTrajectory
+
+if TYPE_CHECKING:
+    from .robot import Robot
+
+__all__ = ["GraspResult", "Gripper", "MotionResult", "RobotArm", "RobotHand"]
+
+
+@dataclass(frozen=True)
+class MotionResult:
+    """What a motion primitive achieved, measured on the backend."""
+
+    ik_success: bool  #: IK converged for the goal (the motion runs anyway, to the best solution)
+    q_goal: np.ndarray
+    duration: float  #: s of simulated time for the trajectory (without settling)
+    max_tracking_error: float  #: rad (or m), max over joints and control ticks of |q_ref - q|
+    final_joint_error: float  #: rad, max |q_goal - q| after settling
+    pos_error: float  #: m, tool frame vs target (backend pose) after settling; nan for joint goals
+    rot_error: float  #: rad, same
+    peak_velocity_ratio: float  #: max over joints of planned peak speed / URDF velocity limit
+    measured_velocity_ratio: float = float("nan")  #: max over joints and control ticks of measured speed / limit
+
+    @property
+    def success(self) -> bool:
+        return bool(self.ik_success)
+
+
+@dataclass(frozen=True)
+class GraspResult:
+    contact: bool  #: a finger link touches the object (or anything, if no object was named)
+    closed: bool  #: the grasp joints reached the fully closed command (nothing in between)
+    actuators: np.ndarray  #: actuator values measured at the end (mean of coupled joints, rescaled)
+    joint_positions: np.ndarray
+    time: float  #: s simulated until the fingers came to rest
+
+
+class RobotArm:
+    """A serial chain ending in a tool frame: an arm, or one finger of a dexterous hand."""
+
+    def __init__(self, config: ArmConfig, robot: "Robot") -> None:
+        self.config = config
+        self.robot = robot
+        self._chain: KinematicChain | None = None
+        jl = robot.urdf_joints
+        self.lower = np.array([jl[j].lower for j in config.joints])
+        self.upper = np.array([jl[j].upper for j in config.joints])
+        self.max_velocity = np.array([jl[j].velocity for j in config.joints])
+        self.effort = np.array([jl[j].effort for j in config.joints])
+
+    @property
+    def name(self) -> str:
+        return self.config.name
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        return self.config.joints
+
+    @property
+    def chain(self) -> KinematicChain:
+        if self._chain is None:
+            c = KinematicChain(self.robot.urdf_text, self.config.base_link, self.config.tcp_link)
+            if tuple(c.joint_names) != tuple(self.config.joints):
+                raise ValueError(
+                    f"{self.robot.name}.{self.name}: URDF chain {self.config.base_link} -> {self.config.tcp_link} "
+                    f"has joints {c.joint_names}, config says {list(self.config.joints)}"
+                )
+            self._chain = c
+        return self._chain
+
+    # -- kinematics (no backend needed) ---------------------------------------
+    def fk(self, q) -> np.ndarray:
+        """Tool frame(s) in the arm's base-link frame, (B, 4, 4)."""
+        return self.chain.fk(q)
+
+    def jacobian(self, q) -> np.ndarray:
+        return self.chain.jacobian(q)
+
+    def ik(
+        self,
+        targets: np.ndarray,
+        *,
+        seed_q=None,
+        generator: torch.Generator | None = None,
+        seed: int = 0,
+        config: IKConfig | None = None,
+    ) -> IKResult:
+        """Batched IK for tool-frame targets in the base-link frame (see :meth:`KinematicChain.ik`)."""
+        cfg = config or self.robot.ik_config
+        if self.config.position_only:
+            from dataclasses import replace
+
+            cfg = replace(cfg, rot_tolerance=float("inf"))
+            return self._ik_position(targets, seed_q, generator, seed, cfg)
+        return self.chain.ik(targets, seed_q=seed_q, generator=generator, seed=seed, config=cfg)
+
+    def _ik_position(self, targets, seed_q, generator, seed, cfg) -> IKResult:
+        """Position-only IK: the target orientation is replaced by the one the chain reaches.
+
+        A 4-DOF finger cannot meet a 6-D pose; pytorch-kinematics' solver
+        weighs orientation, so we iterate on position with a damped
+        Jacobian-transpose-pseudoinverse of the position rows only.
+        """
+        t = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
+        gen = generator if generator is not None else torch.Generator().manual_seed(seed)
+        b = t.shape[0]
+        best_q = np.zeros((b, self.chain.dof))
+        best_e = np.full(b, np.inf)
+        starts = [None] if seed_q is None else [np.broadcast_to(np.asarray(seed_q, float), (b, self.chain.dof))]
+        starts += [self.chain.sample(b, gen) for _ in range(max(cfg.num_retries, 1))]
+        for q in starts:
+            q = self.chain.sample(b, gen) if q is None else np.array(q, dtype=float)
+            for _ in range(cfg.max_iterations):
+                m = self.chain.fk(q)
+                e = t[:, :3, 3] - m[:, :3, 3]
+                j = self.chain.jacobian(q)[:, :3, :]
+                jt = np.transpose(j, (0, 2, 1))
+                lam = 1e-4 + cfg.lm_damping * np.sum(e * e, axis=1)[:, None, None]
+                dq = jt @ np.linalg.solve(j @ jt + lam * np.eye(3), e[:, :, None])
+                q = np.clip(q + cfg.lr * dq[:, :, 0], self.chain.lower, self.chain.upper)
+            err = np.linalg.norm(t[:, :3, 3] - self.chain.fk(q)[:, :3, 3], axis=1)
+            better = err < best_e
+            best_q[better], best_e[better] = q[better], err[better]
+            if np.all(best_e < cfg.pos_tolerance):
+                break
+        return IKResult(best_q, best_e <= cfg.pos_tolerance, best_e, np.zeros(b))
+
+    # -- world frames (needs a spawned robot) -------------------------------------
+    def base_pose(self) -> Pose:
+        return self.robot.backend.get_link_pose(self.robot.body, self.config.base_link)
+
+    def tcp_pose(self) -> Pose:
+        """Tool frame in the world, as the backend reports it."""
+        return self.robot.backend.get_link_pose(self.robot.body, self.config.tcp_link)
+
+    def positions(self) -> np.ndarray:
+        return self.robot.joint_positions(self.joints)
+
+    # -- motion primitives -----------------------------------------------------------
+    def move_to_pose(
+        self,
+        target: Pose,
+        *,
+        duration: float | None = None,
+        velocity_scale: float | None = None,
+        settle: float = 0.3,
+        generator: torch.Generator | None = None,
+        seed: int = 0,
+    ) -> MotionResult:
+        """Move the tool frame to a world pose: IK for the goal, then a tracked joint trajectory.
+
+        The IK is seeded with the current joint positions, so the arm takes
+        the solution nearest to where it is.
+        """
+        base = self.base_pose()
+        local = (base.inv() * target).as_matrix()
+        q_now = self.positions()
+        res = self.ik(local[None], seed_q=q_now, generator=generator, seed=seed)
+        motion = self.move_to_joints(res.q[0], duration=duration, velocity_scale=velocity_scale, settle=settle)
+        reached = self.tcp_pose()
+        dp, dr = pose_error(reached.as_matrix(), target.as_matrix())
+        if self.config.position_only:
+            dr = np.array([np.nan])
+        return MotionResult(bool(res.success[0]), motion.q_goal, motion.duration, motion.max_tracking_error,
+                            motion.final_joint_error, float(dp[0]), float(dr[0]), motion.peak_velocity_ratio,
+                            motion.measured_velocity_ratio)
+
+    def move_to_joints(
+        self,
+        q_goal: Sequence[float],
+        *,
+        duration: float | None = None,
+        velocity_scale: float | None = None,
+        settle: float = 0.3,
+    ) -> MotionResult:
+        """Track a quintic joint trajectory to ``q_goal`` within the velocity limits."""
+        q_goal = np.clip(np.asarray(q_goal, dtype=float), self.lower, self.upper)
+        q0 = self.positions()
+        traj = QuinticTrajectory.plan(
+            q0, q_goal, self.max_velocity,
+            velocity_scale=self.config.velocity_scale if velocity_scale is None else velocity_scale,
+            duration=duration,
+        )
+        track = self.robot.track(self.joints, traj, settle=settle)
+        return MotionResult(
+            True, q_goal, traj.duration, track["max_tracking_error"], track["final_error"],
+            float("nan"), float("nan"), float(np.max(traj.peak_velocity() / self.max_velocity)) if q0.size else 0.0,
+            track["measured_velocity_ratio"],
+        )
+
+
+class Gripper:
+    """A parallel gripper or multi-fingered hand: coupled finger joints, opened and closed with a force cap."""
+
+    def __init__(self, config: GripperConfig, robot: "Robot") -> None:
+        self.config = config
+        self.robot = robot
+        self.coupling = np.asarray(config.coupling, dtype=float)
+        self.command = np.asarray(config.open, dtype=float)
+        self._force = np.asarray(config.force_limit, dtype=float)
+        self._targets = config.joint_targets(self.command)
+        jl = robot.urdf_joints
+        self.lower = np.array([jl[j].lower for j in config.joints])
+        self.upper = np.array([jl[j].upper for j in config.joints])
+
+    @property
+    def name(self) -> str:
+        return self.config.name
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        return self.config.joints
+
+    def set_command(self, u: Sequence[float], force_limit: float | Sequence[float] | None = None) -> None:
+        """Drive the joints towards the coupled targets of actuator values ``u``."""
+        self.command = np.asarray(u, dtype=float)
+        q = np.clip(self.config.joint_targets(self.command), self.lower, self.upper)
+        f = self.config.force_limit if force_limit is None else force_limit
+        self._force = np.broadcast_to(np.asarray(f, dtype=float), (len(q),)).copy()
+        self._targets = q
+        if self.config.follow:
+            pos = self.robot.joint_positions(self.joints)
+            for fj, lj, ratio in self.config.follow:
+                i, k = self.joints.index(fj), self.joints.index(lj)
+                q = q.copy()
+                q[i] = np.clip(ratio * pos[k], self.lower[i], self.upper[i])
+        self.robot.backend.set_joint_targets(
+            self.robot.body, q, np.zeros(len(q)), joints=list(self.joints),
+            stiffness=list(self.config.stiffness), damping=list(self.config.damping),
+            force_limit=self._force.tolist(),
+        )
+
+    def update(self) -> None:
+        """Re-aim follower joints (called every control tick while the robot steps)."""
+        if not self.config.follow or self.robot.body is None:
+            return
+        pos = self.robot.joint_positions(self.joints)
+        vel = self.robot.joint_velocities(self.joints)
+        names, q, k_, d_, f_ = [], [], [], [], []
+        for fj, lj, ratio in self.config.follow:
+            i, k = self.joints.index(fj), self.joints.index(lj)
+            stalled = abs(vel[k]) < 0.05 and abs(self._targets[k] - pos[k]) > 0.02
+            target = self._targets[i] if stalled else np.clip(ratio * pos[k], self.lower[i], self.upper[i])
+            names.append(fj)
+            q.append(float(target))
+            k_.append(self.config.stiffness[i])
+            d_.append(self.config.damping[i])
+            f_.append(float(self._force[i]))
+        self.robot.backend.set_joint_targets(self.robot.body, q, [0.0] * len(q), joints=names,
+                                             stiffness=k_, damping=d_, force_limit=f_)
+
+    def open(self, *, wait: float = 0.5) -> GraspResult:
+        self.set_command(self.config.open)
+        return self._wait(None, wait, self.config.open)
+
+    def close(
+        self,
+        *,
+        force_limit: float | Sequence[float] | None = None,
+        obj: BodyId | None = None,
+        timeout: float = 1.5,
+    ) -> GraspResult:
+        """Close the grasp actuators with joint forces capped at ``force_limit``.
+
+        Returns when the fingers have come to rest (on an object or fully
+        closed) or at ``timeout``; ``contact`` says whether a finger touches
+        ``obj``. Targets persist, so the hand keeps squeezing afterwards.
+        """
+        u = self.command.copy()
+        for k, a in enumerate(self.config.actuators):
+            if a in self.config.grasp_actuators:
+                u[k] = self.config.closed[k]
+        self.set_command(u, force_limit)
+        res = self._wait(obj, timeout, u)
+        if self.config.kind == "parallel" and res.contact and not res.closed:
+            res = self._squeeze(obj, force_limit, res)
+        return res
+
+    def _squeeze(self, obj: BodyId | None, force_limit, first: GraspResult) -> GraspResult:
+        """Re-aim both fingers at the object's middle, a spring squeeze short of it.
+
+        Why: two fingers driven at "fully closed" with the same force cap are
+        both saturated — constant forces with no centring, so the object
+        drifts sideways (DESIGN.md). Aiming each finger ``F / k`` past the
+        measured mid-width makes each an unsaturated spring pressing with
+        ``F`` that pushes the object back to the middle if it moves.
+        """
+        f = np.broadcast_to(np.asarray(self.config.force_limit if force_limit is None else force_limit, float),
+                            (len(self.joints),))
+        k = np.asarray(self.config.stiffness, dtype=float)
+        q = first.joint_positions
+        u = np.array([float(np.mean(q)) - float(np.mean(f / k))])
+        self.set_command(u, 1.5 * f)
+        res = self._wait(obj, 0.5, u)
+        return GraspResult(res.contact, False, res.actuators, res.joint_positions, first.time + res.time)
+
+    def _wait(self, obj: BodyId | None, timeout: float, u_target: np.ndarray) -> GraspResult:
+        r = self.robot
+        dt = r.backend.config.timestep
+        chunk = max(1, int(round(0.02 / dt)))
+        t, rest = 0.0, 0.0
+        names = list(self.joints)
+        while t < timeout:
+            r.step(chunk)  # Robot.step re-aims follower joints
+            t += chunk * dt
+            v = r.joint_velocities(names)
+            rest = rest + chunk * dt if np.max(np.abs(v)) < 0.02 else 0.0
+            if rest >= 0.1 and t >= 0.1:
+                break
+        q = r.joint_positions(names)
+        q_closed = np.clip(self.config.joint_targets(u_target), self.lower, self.upper)
+        closed = bool(np.all(np.abs(q - q_closed) < 0.01 * np.maximum(1.0, np.abs(self.upper - self.lower))))
+        u_meas = np.linalg.lstsq(self.coupling, q, rcond=None)[0]
+        return GraspResult(self.touching(obj), closed, u_meas, q, t)
+
+    def touching(self, obj: BodyId | None = None) -> bool:
+        r = self.robot
+        links = set(self.config.finger_links)
+        for c in r.backend.contacts(r.body, obj):
+            if c.link_a in links and c.body_b != r.body:
+                return True
+        return False
+
+
+#: A dexterous hand is a gripper with more actuators; the name reads better in hand code.
+RobotHand = Gripper

@@ -1,0 +1,261 @@
+"""A :class:`Robot`: a base, arms and grippers/hands, composed from a :class:`RobotConfig`.
+
+The robot owns the link to the simulation (backend + body handle) after
+:meth:`Robot.spawn`; its parts use it. The control loop is here, because
+all parts share it: every joint that no primitive is moving holds its last
+target (with gravity feed-forward), so moving one arm never drops the other
+or opens a hand.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ..backends.interface import Backend, BodyId
+from ..geometry import Pose
+from ..kinematics import IKConfig
+from .config import RobotConfig
+from .description import UrdfJoint, read_joints, read_links
+from .gravity import GravityModel
+from .parts import Gripper, RobotArm
+from .trajectory import QuinticTrajectory
+
+__all__ = ["Robot"]
+
+
+class Robot:
+    """A simulated (or merely kinematic) robot built from a :class:`RobotConfig`."""
+
+    #: control ticks run every this many seconds of simulated time (targets updated, gravity re-fed)
+    control_period: float = 1.0 / 120.0
+
+    def __init__(self, config: RobotConfig, ik_config: IKConfig | None = None) -> None:
+        self.config = config
+        self.ik_config = ik_config or IKConfig()
+        self.urdf_path = Path(config.urdf)
+        if not self.urdf_path.is_file():
+            raise FileNotFoundError(f"robot {config.name!r}: URDF {self.urdf_path} does not exist")
+        self.urdf_text = self.urdf_path.read_text()
+        joints = read_joints(self.urdf_path)
+        self.urdf_joints: dict[str, UrdfJoint] = {j.name: j for j in joints}
+        self.joint_names: list[str] = [j.name for j in joints]
+        self.link_names: list[str] = read_links(self.urdf_path)
+        missing = [j for g in config.groups().values() for j in g if j not in self.urdf_joints]
+        if missing:
+            raise ValueError(f"robot {config.name!r}: joints {missing} are not movable joints of {self.urdf_path}")
+        self.arms: dict[str, RobotArm] = {a.name: RobotArm(a, self) for a in config.arms}
+        self.grippers: dict[str, Gripper] = {g.name: Gripper(g, self) for g in config.grippers}
+        self._gains = self._collect_gains()
+        self._gravity: GravityModel | None = None
+        self.backend: Backend | None = None
+        self.body: BodyId | None = None
+        self._base_rot = np.eye(3)
+        self._gcache: tuple[np.ndarray, dict[str, float]] | None = None
+
+    # -- description -------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.config.name
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
+    def groups(self) -> dict[str, tuple[str, ...]]:
+        return self.config.groups()
+
+    def arm(self, name: str) -> RobotArm:
+        return self.arms[name]
+
+    def gripper(self, name: str) -> Gripper:
+        return self.grippers[name]
+
+    hand = gripper
+
+    def tcp_links(self) -> dict[str, str]:
+        out = {a.name: a.config.tcp_link for a in self.arms.values()}
+        out.update({g.name: g.config.tcp_link for g in self.grippers.values() if g.config.tcp_link})
+        return out
+
+    def home(self) -> np.ndarray:
+        """Home configuration in :attr:`joint_names` order.
+
+        Joints the config's ``home`` does not name take their gripper's open
+        position, or 0; all are clamped to limits.
+        """
+        default: dict[str, float] = {}
+        for g in self.grippers.values():
+            default.update(zip(g.joints, g.config.joint_targets(g.config.open)))
+        q = []
+        for n in self.joint_names:
+            j = self.urdf_joints[n]
+            v = float(self.config.home.get(n, default.get(n, 0.0)))
+            q.append(min(max(v, j.lower), j.upper))
+        return np.array(q)
+
+    def describe(self) -> dict:
+        return {
+            "name": self.name,
+            "dof": self.dof,
+            "urdf": str(self.urdf_path),
+            "groups": {k: list(v) for k, v in self.groups().items()},
+            "tcp_links": self.tcp_links(),
+            "summary": self.config.summary,
+        }
+
+    def _collect_gains(self) -> dict[str, tuple[float, float]]:
+        g: dict[str, tuple[float, float]] = {}
+        for a in self.config.arms:
+            g.update({j: (k, d) for j, k, d in zip(a.joints, a.stiffness, a.damping)})
+        for h in self.config.grippers:
+            g.update({j: (k, d) for j, k, d in zip(h.joints, h.stiffness, h.damping)})
+        g.update(dict(self.config.extra_gains))
+        for n, j in self.urdf_joints.items():
+            if n not in g:
+                e = j.effort if np.isfinite(j.effort) else 100.0
+                g[n] = (100.0 * e, 10.0 * e)
+        return g
+
+    # -- simulation ------------------------------------------------------------------
+    def spawn(self, backend: Backend, base_pose: Pose | None = None, *, q: Sequence[float] | None = None) -> BodyId:
+        """Load the robot into ``backend`` at ``base_pose`` (default: the config's), in home pose, holding it."""
+        pose = base_pose or self.config.base_pose
+        self.backend = backend
+        self.body = backend.load_urdf(self.urdf_path, pose, fixed_base=self.config.fixed_base, name=self.name)
+        names = backend.joint_names(self.body)
+        if names != self.joint_names:
+            raise RuntimeError(f"backend joint order {names} differs from the URDF's {self.joint_names}")
+        self._base_rot = pose.rotation.as_matrix()
+        self._gravity = GravityModel(self.urdf_path, backend.config.gravity)
+        self._gcache = None
+        q0 = self.home() if q is None else np.asarray(q, dtype=float)
+        backend.set_joint_positions(self.body, q0)
+        self._targets = q0.copy()
+        self.hold()
+        for g in self.grippers.values():  # hands keep their home shape
+            qg = q0[[self.joint_names.index(j) for j in g.joints]]
+            g.set_command(np.linalg.lstsq(g.coupling, qg, rcond=None)[0])
+        return self.body
+
+    def _require(self) -> Backend:
+        if self.backend is None or self.body is None:
+            raise RuntimeError(f"robot {self.name!r} is not spawned: call spawn(backend) first")
+        return self.backend
+
+    def joint_positions(self, joints: Sequence[str] | None = None) -> np.ndarray:
+        st = self._require().get_joint_state(self.body)
+        if joints is None:
+            return st.positions
+        return st.positions[[self.joint_names.index(j) for j in joints]]
+
+    def joint_velocities(self, joints: Sequence[str] | None = None) -> np.ndarray:
+        st = self._require().get_joint_state(self.body)
+        if joints is None:
+            return st.velocities
+        return st.velocities[[self.joint_names.index(j) for j in joints]]
+
+    def _gravity_joints(self) -> list[str]:
+        grip = {j for g in self.config.grippers for j in g.joints}
+        return [j for j in self.joint_names if j not in grip]
+
+    def drive(self, joints: Sequence[str], q: np.ndarray, qd: np.ndarray | None = None) -> None:
+        """PD targets for ``joints`` with gravity feed-forward folded into the position target."""
+        be = self._require()
+        joints = list(joints)
+        if not joints:  # nothing to drive
+            return
+        idx = [self.joint_names.index(j) for j in joints]
+        self._targets[idx] = q
+        k = np.array([self._gains[j][0] for j in joints])
+        d = np.array([self._gains[j][1] for j in joints])
+        eff = np.array([self.urdf_joints[j].effort for j in joints])
+        tau = self._gravity_torques(joints)
+        carried = {j for a in self.config.arms if a.gravity_carried for j in a.joints}
+        limit = eff + np.array([abs(t) if j in carried else 0.0 for t, j in zip(tau, joints)])
+        be.set_joint_targets(
+            self.body, q + tau / np.maximum(k, 1e-9), np.zeros(len(joints)) if qd is None else qd,
+            joints=joints, stiffness=k.tolist(), damping=d.tolist(), force_limit=limit.tolist(),
+        )
+
+    def _gravity_torques(self, joints: list[str]) -> np.ndarray:
+        """Gravity holding torques of ``joints`` (0 for hand joints), cached while the robot is still.
+
+        Why the cache: holding still is most of a benchmark's time, and the
+        torques only change when the configuration does (1e-4 rad).
+        """
+        tau = np.zeros(len(joints))
+        gj = set(self._gravity_joints())
+        sel = [i for i, j in enumerate(joints) if j in gj]
+        if not sel or self._gravity is None:
+            return tau
+        q = self.joint_positions()
+        if self._gcache is None or np.max(np.abs(q - self._gcache[0])) > 1e-4:
+            names = self._gravity_joints()
+            self._gcache = (q.copy(), dict(zip(names, self._gravity.torques(dict(zip(self.joint_names, q)), names, self._base_rot))))
+        tau[sel] = [self._gcache[1][joints[i]] for i in sel]
+        return tau
+
+    def hold(self, joints: Sequence[str] | None = None) -> None:
+        """Hold ``joints`` (default: all but the grippers') at their last targets."""
+        js = self._gravity_joints() if joints is None else list(joints)
+        idx = [self.joint_names.index(j) for j in js]
+        self.drive(js, self._targets[idx])
+
+    def step(self, n: int = 1) -> None:
+        """Step the backend in control ticks, letting hands re-aim coupled joints each tick."""
+        be = self._require()
+        per = max(1, int(round(self.control_period / be.config.timestep)))
+        while n > 0:
+            k = min(per, n)
+            be.step(k)
+            n -= k
+            self._tick()
+
+    def _tick(self) -> None:
+        for g in self.grippers.values():
+            g.update()
+
+    def settle(self, seconds: float) -> None:
+        """Step while holding every joint, refreshing gravity feed-forward each control tick."""
+        be = self._require()
+        per = max(1, int(round(self.control_period / be.config.timestep)))
+        ticks = max(1, int(round(seconds / (per * be.config.timestep))))
+        for _ in range(ticks):
+            self.hold()
+            be.step(per)
+            self._tick()
+
+    def track(self, joints: Sequence[str], traj: QuinticTrajectory, *, settle: float = 0.3) -> dict:
+        """Follow a joint trajectory with PD targets (position + velocity), stepping the backend."""
+        be = self._require()
+        dt = be.config.timestep
+        per = max(1, int(round(self.control_period / dt)))
+        joints = list(joints)
+        idx = [self.joint_names.index(j) for j in joints]
+        n_ticks = int(np.ceil(traj.duration / (per * dt)))
+        max_err = 0.0
+        vmax = np.array([self.urdf_joints[j].velocity for j in joints])
+        peak_ratio = 0.0
+        others = [j for j in self._gravity_joints() if j not in joints]
+        for k in range(n_ticks + 1):
+            t = k * per * dt
+            q_ref, qd_ref = traj.sample(t)
+            if k:
+                st = be.get_joint_state(self.body)
+                max_err = max(max_err, float(np.max(np.abs(st.positions[idx] - q_ref))))
+                peak_ratio = max(peak_ratio, float(np.max(np.abs(st.velocities[idx]) / vmax)))
+            self.drive(joints, q_ref, qd_ref)
+            if others:
+                self.hold(others)
+            be.step(per)
+            self._tick()
+        self.settle(settle) if settle > 0 else None
+        final = float(np.max(np.abs(self.joint_positions()[idx] - traj.q1)))
+        return {"max_tracking_error": max_err, "final_error": final, "measured_velocity_ratio": peak_ratio}
+
+    def tcp_poses(self) -> dict[str, Pose]:
+        be = self._require()
+        return {k: be.get_link_pose(self.body, v) for k, v in self.tcp_links().items()}

@@ -1,0 +1,52 @@
+"""Fixtures of the robot tests: robots from the plugin manager, one backend per parameter."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from benchharness.plugin import get_manager
+
+# Batched IK on a 2-core machine shared with other jobs: more torch threads only contend.
+torch.set_num_threads(1)
+
+BACKENDS = ("pybullet", "sapien")
+ROBOTS = ("pr2", "herb", "allegro")
+
+
+@pytest.fixture(scope="session")
+def manager():
+    return get_manager()
+
+
+@pytest.fixture(scope="session")
+def robots(manager):
+    """One kinematic robot object per name (spawning makes a fresh one: see ``make_robot``)."""
+    return {n: manager.create("robot", n) for n in ROBOTS}
+
+
+@pytest.fixture
+def make_backend(manager):
+    made = []
+
+    def _make(name: str):
+        be = manager.create("backend", name)
+        made.append(be)
+        return be
+
+    yield _make
+    for be in made:
+        be.close()
+
+
+@pytest.fixture
+def make_robot(manager):
+    def _make(name: str, **kwargs):
+        return manager.create("robot", name, **kwargs)
+
+    return _make
+
+
+def rng(seed: int) -> np.random.Generator:
+    return np.random.default_rng(seed)

@@ -1,0 +1,64 @@
+"""HERB on each backend: FK oracle, tracked WAM motion, BarrettHand grasping a 5.7 cm cube."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from simhelpers import check_fk_against_backend, check_motion, offset_pose
+
+from benchharness.backends.interface import Box
+from benchharness.geometry import Pose
+
+BACKENDS = ("pybullet", "sapien")
+CUBE_HALF = 0.0285
+CUBE_MASS = 0.094
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_backend_link_poses_match_fk(make_backend, make_robot, backend):
+    be = make_backend(backend)
+    robot = make_robot("herb")
+    robot.spawn(be, Pose([0.0, 0.5, 0.0], [0, 0, np.sin(-0.3), np.cos(-0.3)]))
+    check_fk_against_backend(robot, be)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_arm_tracks_trajectory_to_pose(make_backend, make_robot, backend):
+    be = make_backend(backend)
+    robot = make_robot("herb")
+    robot.spawn(be)
+    arm = robot.arm("right_arm")
+    goal = offset_pose(arm.tcp_pose(), [0.05, -0.05, 0.05], [0.2, 0.0, 0.0])
+    check_motion(arm.move_to_pose(goal, seed=2))
+
+
+@pytest.mark.parametrize(
+    "backend",
+    [
+        pytest.param("pybullet", marks=pytest.mark.xfail(
+            reason="PyBullet: the three-finger pinch holds for 3 of 5 cube offsets of 2-3 mm (SAPIEN: 5 of 5); "
+            "the light BarrettHand finger links exceed their joint limits under contact on PyBullet "
+            "(-0.17 rad at 1 N m), reported to the backends owner", strict=False)),
+        "sapien",
+    ],
+)
+def test_hand_grasps_and_lifts_cube(make_backend, make_robot, backend):
+    be = make_backend(backend)
+    be.add_ground()
+    robot = make_robot("herb")
+    robot.spawn(be)
+    arm, hand = robot.arm("left_arm"), robot.hand("left_hand")
+    tcp = arm.tcp_pose()
+    top = tcp.p[2] - CUBE_HALF
+    be.add_body([Box((0.02, 0.02, top / 2))], Pose([tcp.p[0], tcp.p[1], top / 2]), 1.0, fixed=True, name="pedestal")
+    cube = be.add_body([Box((CUBE_HALF,) * 3)], Pose([tcp.p[0], tcp.p[1], top + CUBE_HALF + 5e-4]), CUBE_MASS,
+                       friction=1.0, name="cube")
+    robot.settle(0.1)
+    g = hand.close(obj=cube, timeout=1.0)
+    assert g.contact and not g.closed
+    c0 = be.get_pose(cube).p.copy()
+    assert arm.move_to_pose(Pose(tcp.p + [0, 0, 0.10], tcp.q)).ik_success
+    robot.settle(1.0)
+    c1 = be.get_pose(cube).p
+    assert c1[2] - c0[2] == pytest.approx(0.10, abs=0.01)
+    assert hand.touching(cube)
