@@ -27,6 +27,7 @@ from typing import Sequence
 import numpy as np
 
 from ..geometry import Pose
+from ._drives import as_array, drive_command
 from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, mass_properties, parse_urdf
 from .interface import (
     Backend,
@@ -86,14 +87,6 @@ class _Body:
         return d
 
 
-def _as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:
-    a = np.asarray(v, dtype=float)
-    if a.ndim == 0:
-        return np.full(n, float(a))
-    a = a.reshape(-1)
-    if a.shape[0] != n:
-        raise BackendError(f"{what}: expected {n} values, got {a.shape[0]}")
-    return a
 
 
 class PyBulletBackend(Backend):
@@ -550,7 +543,7 @@ class PyBulletBackend(Backend):
     def set_joint_positions(self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None) -> None:
         b = self._b(body)
         sel = self._joint_sel(b, joints)
-        pos = _as_array(positions, len(sel), "positions")
+        pos = as_array(positions, len(sel), "positions")
         b.q_prev = None  # a teleport is not motion
         for i, q in zip(sel, pos):
             pb.resetJointState(b.uid, b.joint_index[i], float(q), 0.0, physicsClientId=self._cid)
@@ -571,21 +564,11 @@ class PyBulletBackend(Backend):
         n = len(sel)
         if n == 0:
             return
-        k = _as_array(stiffness, n, "stiffness")
-        d = _as_array(damping, n, "damping")
-        if force_limit is None:
-            f = np.array([b.joints[i].max_effort for i in sel])
-        else:
-            f = _as_array(force_limit, n, "force_limit")
-        f = np.where(np.isfinite(f), f, 1.0e9)
-        if positions is None:
-            st = self.get_joint_state(body)
-            q = st.positions[sel] if velocities is not None else st.positions[sel]
-            if velocities is not None:
-                k = np.zeros(n)  # a pure velocity drive
-        else:
-            q = _as_array(positions, n, "positions")
-        v = np.zeros(n) if velocities is None else _as_array(velocities, n, "velocities")
+        cmd = drive_command(
+            b.joints, sel, positions, velocities, stiffness, damping, force_limit,
+            lambda: self.get_joint_state(body).positions,
+        )
+        q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
         b.target_q[sel], b.target_v[sel], b.kp[sel], b.kd[sel], b.fmax[sel] = q, v, k, d, f
         b.driven[sel] = True
         b.driven_idx = np.nonzero(b.driven)[0]
@@ -594,7 +577,7 @@ class PyBulletBackend(Backend):
     def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
         b = self._b(body)
         sel = self._joint_sel(b, joints)
-        t = _as_array(torques, len(sel), "torques")
+        t = as_array(torques, len(sel), "torques")
         for i, tau in zip(sel, t):
             b.friction[i] = float(tau)
             if not b.driven[i]:
