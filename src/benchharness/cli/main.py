@@ -16,6 +16,10 @@ SUBCOMMANDS = {
     "inhand": ("benchharness.cli.inhand", "inhand"),
     "robots": ("benchharness.cli.robots", "robots_cmd"),
     "robot": ("benchharness.cli.robots", "robot"),
+    "run": ("benchharness.cli.run", "run"),
+    "table": ("benchharness.cli.run", "table"),
+    "compare": ("benchharness.cli.run", "compare"),
+    "results": ("benchharness.cli.run", "results"),
 }
 
 

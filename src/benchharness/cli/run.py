@@ -1,0 +1,530 @@
+"""``benchharness run | table | compare | results``: simulation sweeps and their reports.
+
+Thin: parse options into a :class:`~benchharness.runner.RunSpec`, call the
+runner, print. Exit codes (as everywhere): 0 every selected trial succeeded,
+1 some trial failed (a tier not completed), 2 bad input (unknown robot,
+strategy, task ..., with the plugin manager's message). See docs/runner.md.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+import click
+
+from .common import EXIT_NEGATIVE, emit_json, fail, json_option
+
+_CTX = {"help_option_names": ["-h", "--help"], "max_content_width": 110}
+
+
+def _console(stderr: bool = False):
+    from rich.console import Console
+
+    console = Console(stderr=stderr)
+    if not console.is_terminal:  # piped or captured: do not wrap at 80 columns
+        console = Console(width=220, stderr=stderr)
+    return console
+
+
+def _fmt(x: float | None, digits: int = 2) -> str:
+    if x is None:
+        return "—"
+    try:
+        if x != x:  # NaN
+            return "—"
+    except TypeError:
+        return str(x)
+    return f"{x:.{digits}f}" if abs(x) >= 10 ** -digits or x == 0 else f"{x:.2g}"
+
+
+def _esc(text: object) -> str:
+    """Cell text without rich markup (task ids and messages may hold brackets)."""
+    from rich.markup import escape
+
+    return escape(str(text))
+
+
+def _names(text: str | None) -> tuple[str, ...]:
+    return tuple(n.strip() for n in (text or "").split(",") if n.strip())
+
+
+def store_option(f: Callable) -> Callable:
+    return click.option(
+        "--store", "store_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+        help="Results store (SQLite). Default: $BENCHHARNESS_STORE, else ./benchharness-results.sqlite.",
+    )(f)
+
+
+def _open_store(path: Path | None):
+    from ..runner.store import ResultsStore, StoreError
+
+    try:
+        return ResultsStore(path)
+    except StoreError as exc:
+        fail(str(exc))
+
+
+def run_options(f: Callable) -> Callable:
+    """Options shared by ``run`` and ``compare`` (everything but the backend)."""
+    opts = [
+        click.option("--task", required=True, help="Rubik's tier (Rubiks-5-20) or in-hand task set (inhand-level1)."),
+        click.option("--robot", required=True, help="Robot plugin name (benchharness plugins)."),
+        click.option("--strategy", required=True, help="Strategy plugin name."),
+        click.option("--seed", type=int, default=0, show_default=True,
+                     help="Run seed: the protocol's sequences and every trial's random streams."),
+        click.option("--sensors", default="", help="Comma-separated sensor plugin names."),
+        click.option("--workers", type=int, default=None,
+                     help="Worker processes (default: half the cores, at least 1; 0 runs in this process)."),
+        click.option("--trials", "trial_sel", default=None, help="Only these trial indices, e.g. 1,3-5 (default all)."),
+        click.option("--repeats", type=int, default=1, show_default=True, help="In-hand: trials per task row."),
+        click.option("--physics", "physics_kv", multiple=True, metavar="KEY=VALUE",
+                     help="PhysicsConfig setting, repeatable: timestep=1/500, solver_iterations=100, ..."),
+        click.option("--sim-budget", type=float, default=None,
+                     help="Simulated seconds per trial (default Rubik's 120 + 60 per move; in-hand 120)."),
+        click.option("--wall-budget", type=float, default=None,
+                     help="Wall-clock seconds per trial (default none: results then never depend on machine speed)."),
+        click.option("--plugin", "plugins", multiple=True, metavar="MODULE",
+                     help="Also register this importable plugin module (a strategy under development)."),
+        click.option("--retry-failed", is_flag=True, help="Re-run stored failed trials instead of skipping them."),
+        click.option("--progress/--no-progress", default=None, help="Progress bar on stderr (default: when a terminal)."),
+        store_option,
+        json_option,
+    ]
+    for o in reversed(opts):
+        f = o(f)
+    return f
+
+
+def _spec(task, robot, strategy, backend, seed, sensors, repeats, physics_kv, sim_budget, wall_budget, plugins):
+    from ..plugin import PluginNotFoundError
+    from ..runner.contract import TimeBudget
+    from ..runner.plugins import lookup
+    from ..runner.spec import RunSpec, parse_physics
+    from ..runner.tasks import plan_task
+
+    try:
+        physics = parse_physics(list(physics_kv))
+    except ValueError as exc:
+        fail(f"--physics: {exc}")
+    if repeats < 1:
+        fail("--repeats must be at least 1")
+    for name, value in (("--sim-budget", sim_budget), ("--wall-budget", wall_budget)):
+        if value is not None and value <= 0:
+            fail(f"{name} must be positive")
+    try:
+        item = lookup("task", task, tuple(plugins))
+        plan = plan_task(item.name, item.create(), seed, repeats)
+    except (PluginNotFoundError, TypeError, ValueError) as exc:
+        fail(str(exc))
+    if sim_budget is None:
+        if plan.benchmark == "rubiks":
+            first = next(iter(plan.items.values()))
+            sim_budget = 120.0 + 60.0 * len(first.sequence)
+        else:
+            sim_budget = 120.0
+    return RunSpec(
+        task=plan.name, robot=robot, strategy=strategy, backend=backend, seed=seed, sensors=_names(sensors),
+        physics=physics, budget=TimeBudget(sim_budget, wall_budget), repeats=repeats, plugins=tuple(plugins),
+    )
+
+
+class _Progress:
+    """A rich progress bar: trials done / total, failures, ETA."""
+
+    def __init__(self, enabled: bool, label: str) -> None:
+        self.enabled, self.label = enabled, label
+        self.progress = None
+        self.task = None
+        self.failures = 0
+
+    def start(self, report, pending: int) -> None:
+        if not self.enabled:
+            return
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+        self.progress = Progress(
+            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+            TextColumn("failures: {task.fields[failures]}"), TimeElapsedColumn(), TextColumn("ETA"),
+            TimeRemainingColumn(), console=_console(stderr=True), transient=False,
+        )
+        self.progress.start()
+        self.task = self.progress.add_task(self.label, total=pending, failures=0)
+
+    def record(self, rec) -> None:
+        if self.progress is None:
+            return
+        self.failures += rec.failed
+        self.progress.update(self.task, advance=1, failures=self.failures)
+
+    def stop(self) -> None:
+        if self.progress is not None:
+            self.progress.stop()
+
+
+def _sweep(spec, store, workers, trial_sel, retry_failed, progress, video=None):
+    import sys
+
+    from ..plugin import PluginNotFoundError
+    from ..runner.sweep import default_workers, run_sweep
+
+    workers = default_workers() if workers is None else workers
+    if workers < 0:
+        fail("--workers must be 0 or more")
+    show = sys.stderr.isatty() if progress is None else progress
+    bar = _Progress(show, f"{spec.task} {spec.strategy}/{spec.robot}/{spec.backend}")
+    try:
+        return run_sweep(spec, store, workers=workers, trials=trial_sel, retry_failed=retry_failed, video=video,
+                         on_start=bar.start, on_record=bar.record)
+    except (PluginNotFoundError, ValueError, TypeError) as exc:
+        fail(str(exc))
+    except KeyboardInterrupt:
+        bar.stop()
+        n = store.count(spec.run_key)
+        fail(f"interrupted; {n} trial(s) of run {spec.run_key} are in {store.path}. "
+             "Re-run the same command to resume.", 130)
+    finally:
+        bar.stop()
+
+
+def _trial_json(t) -> dict[str, Any]:
+    return {
+        "run_key": t.run_key, "trial": t.trial_index, "task": t.task, "robot": t.robot, "strategy": t.strategy,
+        "sensors": t.sensors, "backend": t.backend, "seed": t.seed, "status": t.status.value, "score": t.score,
+        "failure_cause": t.failure_cause.value if t.failure_cause else None, "message": t.message,
+        "wall_s": t.wall_s, "sim_s": t.sim_s, "first_contact_s": t.first_contact_s,
+        "termination_s": t.termination_s, "code_version": t.code_version, "physics_hash": t.physics_hash,
+    }
+
+
+def _trials_table(rows, title: str, show_run: bool = False):
+    from rich.table import Table
+
+    table = Table(title=title)
+    if show_run:
+        for c in ("task", "method", "seed"):
+            table.add_column(c, no_wrap=True)
+    for c, j in (("trial", "right"), ("status", "left"), ("score", "right"), ("cause", "left"),
+                 ("sim s", "right"), ("wall s", "right"), ("message", "left")):
+        table.add_column(c, justify=j)
+    for t in rows:
+        lead = [_esc(t.task), _esc(t.method), str(t.seed)] if show_run else []
+        table.add_row(*lead, str(t.trial_index), t.status.value, _fmt(t.score, 3),
+                      t.failure_cause.value if t.failure_cause else "", _fmt(t.sim_s, 2), _fmt(t.wall_s, 2),
+                      _esc((t.message or "")[:90]))
+    return table
+
+
+def _summary(spec, store, benchmark: str, total: int, selected: Sequence[int]):
+    from ..cube import get_tier
+    from ..runner.reports import rubiks_cell
+
+    rows = [t for t in store.trials(run_key=spec.run_key) if t.trial_index in set(selected)]
+    cell = None
+    if benchmark == "rubiks":
+        cell = rubiks_cell(store.trials(run_key=spec.run_key), get_tier(spec.task).trials)
+    return rows, cell
+
+
+# -- run ---------------------------------------------------------------------------------------
+
+
+@click.command("run", context_settings=_CTX)
+@run_options
+@click.option("--backend", default="pybullet", show_default=True, help="Backend plugin name (pybullet, sapien).")
+@click.option("--video", "video_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Record one trial as MP4 (GIF if the path ends .gif) through Backend.render.")
+@click.option("--video-trial", type=int, default=1, show_default=True, help="Which trial --video records.")
+@click.option("--video-fps", type=float, default=30.0, show_default=True, help="Frames per *simulated* second.")
+def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physics_kv, sim_budget, wall_budget,
+        plugins, retry_failed, progress, store_path, as_json, backend, video_path, video_trial, video_fps) -> None:
+    """Run a task's trials with a robot, strategy, sensors and backend; store each as it ends.
+
+    Re-running the same command resumes: trials already in the store under the
+    same run key (task, robot, strategy, sensors, backend, seed, physics,
+    budgets, code version) are skipped.
+
+    \b
+    Examples:
+      benchharness run --task Rubiks-5-20 --robot pr2 --strategy sensor-aided --backend pybullet --seed 0
+      benchharness run --task inhand-level1 --robot allegro --strategy relaxed-rigidity --repeats 5
+      benchharness run --task Rubiks-1-5 --robot pr2 --strategy dead-reckoning --video trial1.mp4
+    """
+    spec = _spec(task, robot, strategy, backend, seed, sensors, repeats, physics_kv, sim_budget, wall_budget, plugins)
+    video = None
+    if video_path is not None:
+        from ..runner.plugins import lookup
+        from ..runner.video import VideoSpec
+
+        try:
+            item = lookup("backend", backend, spec.plugins)
+        except Exception as exc:  # noqa: BLE001 - PluginNotFoundError: the manager's message
+            fail(str(exc))
+        caps = item.meta.get("capabilities") or {}
+        if not caps.get("camera", False):
+            fail(f"--video needs a backend that can render images; backend {backend!r} has no camera "
+                 f"(capabilities.camera is false). Use --backend pybullet.")
+        try:
+            video = VideoSpec(video_path, video_trial, video_fps)
+        except ValueError as exc:
+            fail(str(exc))
+    with _open_store(store_path) as store:
+        t0 = time.perf_counter()
+        report = _sweep(spec, store, workers, trial_sel, retry_failed, progress, video)
+        elapsed = time.perf_counter() - t0
+        rows, cell = _summary(spec, store, report.plan.benchmark, report.plan.total, report.selected)
+        video_info = None
+        if video is not None:
+            rec = next((r for r in report.records if r.trial_index == video.trial_index), None)
+            video_info = rec.diagnostics.get("video") if rec is not None else None
+        failed = any(r.status.value == "failure" for r in rows)
+        if as_json:
+            emit_json({
+                "run": spec.to_json(), "store": str(store.path), "benchmark": report.plan.benchmark,
+                "trials_total": report.plan.total, "selected": report.selected, "ran": report.ran,
+                "skipped": report.skipped, "failures": sum(r.status.value == "failure" for r in rows),
+                "elapsed_s": elapsed, "tier": None if cell is None else cell.to_dict(),
+                "video": video_info, "trials": [_trial_json(t) for t in rows],
+            })
+        else:
+            console = _console()
+            console.print(_trials_table(rows, _esc(f"{spec.task}: {spec.strategy} on {spec.robot}, {spec.backend}, seed {spec.seed}")))
+            console.print(f"run {spec.run_key} in {store.path}: ran {report.ran}, skipped {len(report.skipped)} "
+                          f"already stored, {elapsed:.1f} s")
+            if cell is not None:
+                from ..runner.reports import format_cell
+
+                state = "completed" if cell.completed else "not completed"
+                console.print(f"{spec.task}: {state} — {format_cell(cell)} s "
+                              f"({cell.successes}/{cell.trials_required} trials in the expected state)")
+            if video_info:
+                console.print(f"video: {video_info['path']} ({video_info['frames']} frames at {video_info['fps']:g} fps)"
+                              + (f" — {video_info['note']}" if video_info.get("note") else ""))
+        if failed:
+            raise SystemExit(EXIT_NEGATIVE)
+
+
+# -- table -------------------------------------------------------------------------------------
+
+
+@click.command("table", context_settings=_CTX)
+@store_option
+@click.option("--benchmark", type=click.Choice(["rubiks", "inhand"]), default=None,
+              help="Which paper's tables (default: each benchmark present in the store).")
+@click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
+@click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
+@click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
+@click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
+@click.option("--run-tiers", is_flag=True, help="Rubik's: only tiers with results (default all twelve, as in the paper).")
+@json_option
+def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers, as_json) -> None:
+    """Our results in the papers' layouts, with the published figures beside them.
+
+    \b
+    Rubik's (Table I): tiers × methods, mean / std of the trial scores in
+    seconds (sample std; "-" for single-trial tiers) where the tier was
+    completed, "—" where not (with successes/M), "… k/M run" while trials
+    are missing. In-hand: Table II (per method: drops %, medians of err_pos,
+    err_pos%, err_or%) and Table III (per task).
+    """
+    from ..runner.reports import format_cell, inhand_table2, inhand_table3, rubiks_table
+
+    with _open_store(store_path) as store:
+        filters = dict(strategy=list(strategies) or None, backend=list(backends) or None,
+                       robot=list(robots) or None, seed=list(seeds) or None)
+        trials = store.trials(benchmark=benchmark, **filters)
+    present = {t.benchmark for t in trials}
+    wanted = [benchmark] if benchmark else [b for b in ("rubiks", "inhand") if b in present] or ["rubiks"]
+    out: dict[str, Any] = {}
+    console = None if as_json else _console()
+    if "rubiks" in wanted:
+        tab = rubiks_table(trials, all_tiers=not run_tiers)
+        if as_json:
+            out["rubiks"] = tab.to_dict()
+        else:
+            from rich.table import Table
+
+            t = Table(title="Rubik's cube benchmark (Table I layout): mean / std of trial time, s; — not completed")
+            t.add_column("Tier", no_wrap=True)
+            for _, label in tab.published:
+                t.add_column(f"{label} (paper)", justify="right")
+            for c in tab.columns:
+                t.add_column(_esc(c.label), justify="right")
+            for tier in tab.tiers:
+                t.add_row(tier, *[tab.published_cell(tier, k) for k, _ in tab.published],
+                          *[format_cell(tab.cells.get((tier, c.label))) for c in tab.columns])
+            console.print(t)
+            if not tab.columns:
+                console.print("No Rubik's results in the store yet (benchharness run --task Rubiks-...).")
+    if "inhand" in wanted:
+        t2, t3 = inhand_table2(trials), inhand_table3(trials)
+        if as_json:
+            out["inhand"] = {"table2": t2, "table3": t3}
+        else:
+            from rich.table import Table
+
+            from ..runner.published import TABLE_III_ROWS
+
+            t = Table(title="In-hand benchmark (Table II layout): medians over trials")
+            for c, j in (("method", "left"), ("source", "left"), ("n", "right"), ("drops %", "right"),
+                         ("err_pos (cm)", "right"), ("err_pos%", "right"), ("err_or%", "right"),
+                         ("other failures", "right")):
+                t.add_column(c, justify=j)
+            for r in t2:
+                t.add_row(_esc(r["method"]), r["source"], str(r.get("trials", "")), _fmt(r.get("drops_percent"), 1),
+                          _fmt(r.get("err_pos_cm")), _fmt(r.get("err_pos_percent")), _fmt(r.get("err_or_percent")),
+                          str(r.get("failed_other", "")))
+            console.print(t)
+            methods: dict[str, list] = {}
+            for r in t3:
+                methods.setdefault(r["method"], []).append(r)
+            for method, rows in methods.items():
+                t = Table(title=_esc(f"Table III layout: {method} per task (ours | paper DMG)"))
+                t.add_column("metric")
+                for r in rows:
+                    t.add_column(_esc(f"{r['object']} [{r['task_id']}]"), justify="right")
+                for key, label in TABLE_III_ROWS.items():
+                    if key.startswith("g_"):
+                        continue  # contact metrics need meshes the runner does not have yet
+                    cells = []
+                    for r in rows:
+                        paper = r["paper"].get(key)
+                        ours = r["ours"].get(key)
+                        cells.append(f"{_fmt(ours, 3)} | {_fmt(paper, 3) if paper is not None else ''}")
+                    t.add_row(label, *cells)
+                t.add_row("drops %", *[_fmt(r["drops_percent"], 1) for r in rows])
+                console.print(t)
+    if as_json:
+        emit_json(out)
+
+
+# -- compare -----------------------------------------------------------------------------------
+
+
+@click.command("compare", context_settings=_CTX)
+@run_options
+@click.option("--backends", default="pybullet,sapien", show_default=True, help="Comma-separated backends to compare.")
+def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physics_kv, sim_budget, wall_budget,
+            plugins, retry_failed, progress, store_path, as_json, backends) -> None:
+    """Run the same trials on several backends and show them side by side.
+
+    Each backend's run is an ordinary stored run (so it resumes, and shows up
+    in ``table``); the comparison is per trial: status, score, failure cause,
+    simulated and wall time, and per backend the tier score and the
+    real-time factor (simulated s / wall s).
+
+    \b
+    Example:
+      benchharness compare --backends pybullet,sapien --task Rubiks-1-5 --robot pr2 --strategy sensor-aided
+    """
+    from ..runner.reports import compare_backends
+
+    names = _names(backends)
+    if len(names) < 2:
+        fail("--backends: name at least two backends, comma-separated")
+    runs = []
+    with _open_store(store_path) as store:
+        benchmark = None
+        required = None
+        for b in names:
+            spec = _spec(task, robot, strategy, b, seed, sensors, repeats, physics_kv, sim_budget, wall_budget, plugins)
+            report = _sweep(spec, store, workers, trial_sel, retry_failed, progress)
+            benchmark = report.plan.benchmark
+            required = report.plan.total if trial_sel is None else None
+            sel = set(report.selected)
+            runs.append((b, [t for t in store.trials(run_key=spec.run_key) if t.trial_index in sel]))
+    data = compare_backends(runs, required)
+    if as_json:
+        emit_json({"task": task, "benchmark": benchmark, "backends": list(names), **data})
+        return
+    from rich.table import Table
+
+    console = _console()
+    t = Table(title=f"{task}: {strategy} on {robot}, seed {seed} — per backend")
+    t.add_column("trial", justify="right")
+    for b in names:
+        t.add_column(f"{b}: status", no_wrap=True)
+        t.add_column(f"{b}: score", justify="right")
+        t.add_column(f"{b}: sim s", justify="right")
+    for row in data["trials"]:
+        cells = [str(row["trial"])]
+        for b in names:
+            c = row[b]
+            if c is None:
+                cells += ["", "", ""]
+            else:
+                cells += [c["cause"] or c["status"], _fmt(c["score"], 3), _fmt(c["sim_s"], 2)]
+        t.add_row(*cells)
+    console.print(t)
+    s = Table(title="summary")
+    for c in ("backend", "trials", "successes", "completed", "mean / std s", "failure causes", "real-time factor"):
+        s.add_column(c)
+    for b in names:
+        v = data["summary"][b]
+        causes = ", ".join(f"{k}×{n}" for k, n in v["causes"].items())
+        ms = "" if v["mean_s"] is None else f"{v['mean_s']:.2f} / {_fmt(v['std_s'])}"
+        s.add_row(b, str(v["trials"]), str(v["successes"]), "" if v["completed"] is None else str(v["completed"]).lower(),
+                  ms, causes, _fmt(v["real_time_factor"], 2))
+    console.print(s)
+
+
+# -- results -----------------------------------------------------------------------------------
+
+
+@click.command("results", context_settings=_CTX)
+@store_option
+@click.option("--failures", is_flag=True, help="Only failed trials.")
+@click.option("--task", "tasks", multiple=True, help="Only these tasks (repeatable).")
+@click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
+@click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
+@click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
+@click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
+@click.option("--run", "run_prefix", default=None, help="Only the run whose key starts with this.")
+@click.option("--traceback", "show_tb", is_flag=True, help="Print each failed trial's traceback.")
+@click.option("--plot-pose-error", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write a PNG of cube pose-estimate error against move index, per method.")
+@json_option
+def results(store_path, failures, tasks, strategies, backends, robots, seeds, run_prefix, show_tb, plot_path,
+            as_json) -> None:
+    """List stored trials with status, score and failure cause.
+
+    \b
+    Examples:
+      benchharness results --failures --traceback
+      benchharness results --task Rubiks-1-50 --plot-pose-error drift.png
+    """
+    with _open_store(store_path) as store:
+        rows = store.trials(
+            failures_only=failures, task=list(tasks) or None, strategy=list(strategies) or None,
+            backend=list(backends) or None, robot=list(robots) or None, seed=list(seeds) or None,
+        )
+    if run_prefix:
+        rows = [t for t in rows if t.run_key.startswith(run_prefix)]
+    plotted = None
+    if plot_path is not None:
+        from ..runner.plots import plot_pose_error
+
+        try:
+            plotted = str(plot_pose_error(rows, plot_path))
+        except ValueError as exc:
+            fail(str(exc), EXIT_NEGATIVE)
+    if as_json:
+        data = []
+        for t in rows:
+            d = _trial_json(t)
+            if show_tb:
+                d["traceback"] = t.traceback
+            d["diagnostics_counts"] = t.diagnostics.get("counts", {})
+            data.append(d)
+        emit_json({"trials": data, "plot": plotted})
+        return
+    console = _console()
+    console.print(_trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True))
+    if show_tb:
+        for t in rows:
+            if t.traceback:
+                console.rule(f"{t.task} {t.method} seed {t.seed} trial {t.trial_index}")
+                console.print(t.traceback, markup=False, highlight=False)
+    if plotted:
+        console.print(f"pose-error plot written to {plotted}")

@@ -1,0 +1,309 @@
+"""Tables from the store, laid out like the papers' (data only; the CLI prints them).
+
+* :func:`rubiks_table` — Table I: tiers × methods, mean / std seconds of the
+  trial scores where the tier was *completed* (every one of its M trials ended
+  in the expected state), ``—`` where not; the published baselines beside.
+* :func:`inhand_table2` — Table II: per method, drops % and median err_pos,
+  err_pos%, err_or%; the paper's methods beside.
+* :func:`inhand_table3` — Table III: per task, the metrics of one method;
+  the paper's DMG figures beside.
+* :func:`compare_backends` — one run's trials on several backends, side by side.
+
+Every number comes from :mod:`benchharness.metrics` (``mean_and_std``,
+``score_trials``, ``summarize_scores``) over the stored outcomes.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Sequence
+
+import numpy as np
+
+from ..cube import get_tier, load_tiers
+from ..cube.tiers import UnknownTierError
+from ..metrics import mean_and_std, score_trials, summarize_scores
+from .causes import TrialStatus
+from .published import TABLE_II, TABLE_III
+from .store import StoredTrial, group_by_run
+
+__all__ = [
+    "Column",
+    "RubiksCell",
+    "RubiksTable",
+    "rubiks_table",
+    "inhand_table2",
+    "inhand_table3",
+    "compare_backends",
+    "format_cell",
+]
+
+_DISTINGUISH = ("seed", "physics_hash", "options_hash", "code_version")
+
+
+@dataclass(frozen=True)
+class Column:
+    """A method: everything in the run key but the task."""
+
+    label: str
+    robot: str
+    strategy: str
+    sensors: str
+    backend: str
+    seed: int
+    physics_hash: str
+    options_hash: str
+    code_version: str
+
+    @property
+    def key(self) -> tuple:
+        return (self.robot, self.strategy, self.sensors, self.backend, self.seed, self.physics_hash,
+                self.options_hash, self.code_version)
+
+
+def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Column]]:
+    """Columns in first-seen order, labelled as briefly as still tells them apart."""
+    raw: dict[tuple, StoredTrial] = {}
+    by_run: dict[str, tuple] = {}
+    for t in trials:
+        k = (t.robot, t.strategy, t.sensors, t.backend, t.seed, t.physics_hash, t.options_hash, t.code_version)
+        raw.setdefault(k, t)
+        by_run[t.run_key] = k
+    base: dict[tuple, str] = {k: t.method for k, t in raw.items()}
+    labels: dict[tuple, str] = {}
+    for k, t in raw.items():
+        same = [o for o, lab in base.items() if lab == base[k] and o != k]
+        extra = []
+        for f in _DISTINGUISH:
+            if any(getattr(raw[o], f) != getattr(t, f) for o in same):
+                extra.append(f"seed {t.seed}" if f == "seed" else f"{f.split('_')[0]} {getattr(t, f)}")
+        labels[k] = base[k] + (" " + ", ".join(extra) if extra else "")
+    cols = {k: Column(labels[k], *k) for k in raw}
+    return list(cols.values()), {run: cols[k] for run, k in by_run.items()}
+
+
+@dataclass(frozen=True)
+class RubiksCell:
+    trials_required: int
+    trials_run: int
+    successes: int
+    completed: bool
+    mean_s: float | None
+    std_s: float | None
+    causes: dict[str, int] = field(default_factory=dict)
+    sim_s_mean: float | None = None
+    wall_s_mean: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def rubiks_cell(trials: Sequence[StoredTrial], required: int) -> RubiksCell:
+    indices = {t.trial_index for t in trials}
+    ok = [t for t in trials if t.status is TrialStatus.SUCCESS and t.score is not None]
+    completed = indices == set(range(1, required + 1)) and len(ok) == required
+    mean, std = mean_and_std([t.score for t in ok])
+    causes = Counter(t.failure_cause.value for t in trials if t.failure_cause is not None)
+    sims = [t.sim_s for t in trials if t.sim_s is not None]
+    walls = [t.wall_s for t in trials if t.wall_s is not None]
+    return RubiksCell(required, len(indices), len(ok), completed, mean, std, dict(causes),
+                      float(np.mean(sims)) if sims else None, float(np.mean(walls)) if walls else None)
+
+
+def format_cell(cell: RubiksCell | None) -> str:
+    """Table I's notation: ``mean / std`` (``-`` for no std), ``—`` not completed."""
+    if cell is None:
+        return ""
+    if cell.completed:
+        std = "-" if cell.std_s is None else f"{cell.std_s:.2f}"
+        return f"{cell.mean_s:.2f} / {std}"
+    failed = cell.trials_run - cell.successes
+    if failed == 0 and cell.trials_run < cell.trials_required:
+        return f"… {cell.trials_run}/{cell.trials_required} run"
+    return f"— ({cell.successes}/{cell.trials_required})"
+
+
+@dataclass(frozen=True)
+class RubiksTable:
+    tiers: list[str]
+    published: list[tuple[str, str]]  # (baseline key, label)
+    columns: list[Column]
+    cells: dict[tuple[str, str], RubiksCell]  # (tier, column label) -> cell
+
+    def published_cell(self, tier: str, key: str) -> str:
+        for b in get_tier(tier).baselines:
+            if b.key == key:
+                if not b.completed:
+                    return "—"
+                return f"{b.mean_s:.2f} / {'-' if b.std_s is None else f'{b.std_s:.2f}'}"
+        return ""
+
+    def to_dict(self) -> dict[str, Any]:
+        tiers = load_tiers()
+        out = []
+        for tier in self.tiers:
+            row: dict[str, Any] = {"tier": tier, "published": {}, "ours": {}}
+            for b in tiers[tier].baselines:
+                row["published"][b.label] = {"completed": b.completed, "mean_s": b.mean_s, "std_s": b.std_s}
+            for c in self.columns:
+                cell = self.cells.get((tier, c.label))
+                if cell is not None:
+                    row["ours"][c.label] = cell.to_dict()
+            out.append(row)
+        return {"columns": [c.__dict__ for c in self.columns], "rows": out}
+
+
+def rubiks_table(trials: Sequence[StoredTrial], *, all_tiers: bool = True) -> RubiksTable:
+    trials = [t for t in trials if t.benchmark == "rubiks"]
+    columns, col_of = _columns(trials)
+    cells: dict[tuple[str, str], RubiksCell] = {}
+    seen_tiers: list[str] = []
+    for run, rows in group_by_run(trials):
+        try:
+            tier = get_tier(rows[0].task)
+        except UnknownTierError:
+            continue
+        seen_tiers.append(tier.name)
+        cells[(tier.name, col_of[run].label)] = rubiks_cell(rows, tier.trials)
+    known = load_tiers()
+    tiers = [t for t in known if all_tiers or t in seen_tiers]
+    first = next(iter(known.values()))
+    published = [(b.key, b.label) for b in first.baselines]
+    return RubiksTable(tiers, published, columns, cells)
+
+
+# -- in-hand ---------------------------------------------------------------------------------
+
+_INHAND_FIELDS = ("initial", "desired", "reached", "setup")
+
+
+def _inhand_arrays(trials: Sequence[StoredTrial]) -> dict[str, np.ndarray]:
+    def pose(t: StoredTrial, k: str) -> list[float]:
+        v = t.outcome.get(k) or [None] * 7
+        return [np.nan if x is None else float(x) for x in v]
+
+    def num(t: StoredTrial, k: str) -> float:
+        v = t.outcome.get(k)
+        return np.nan if v is None else float(v)
+
+    return {
+        **{k: np.array([pose(t, k) for t in trials], float).reshape(-1, 7) for k in _INHAND_FIELDS},
+        "dropped": np.array([bool(t.outcome.get("dropped")) for t in trials], bool),
+        "plan_time_s": np.array([num(t, "plan_time_s") for t in trials], float),
+        "exec_time_s": np.array([num(t, "exec_time_s") for t in trials], float),
+    }
+
+
+def _scorable(trials: Iterable[StoredTrial]) -> tuple[list[StoredTrial], list[StoredTrial]]:
+    """Trials with a pose outcome (scored, dropped or discarded) and the others (errors, timeouts...)."""
+    scored, other = [], []
+    for t in trials:
+        if t.benchmark != "inhand":
+            continue
+        if t.status is not TrialStatus.FAILURE or t.outcome.get("dropped"):
+            scored.append(t)
+        else:
+            other.append(t)
+    return scored, other
+
+
+def _median(stats, name: str, scale: float = 1.0) -> float | None:
+    s = stats[name]
+    return None if s.n == 0 else float(s.median * scale)
+
+
+def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
+    """Table II rows: ours (one per method) then the paper's, with ``source``."""
+    scored, other = _scorable(trials)
+    columns, col_of = _columns([t for t in trials if t.benchmark == "inhand"])
+    rows: list[dict[str, Any]] = []
+    if scored:
+        a = _inhand_arrays(scored)
+        s = score_trials(a["initial"], a["desired"], a["reached"], setup=a["setup"], dropped=a["dropped"],
+                         plan_time_s=a["plan_time_s"], exec_time_s=a["exec_time_s"])
+        labels = np.array([col_of[t.run_key].label for t in scored], dtype=object)
+        for g in summarize_scores(s, {"method": labels}, ("method",), a["dropped"]):
+            label = g.key[0]
+            rows.append({
+                "source": "ours", "method": label, "trials": g.n_trials, "discarded": g.n_discarded,
+                "drops_percent": g.drops_percent,
+                "err_pos_cm": _median(g.stats, "err_pos", 100.0),
+                "err_pos_percent": _median(g.stats, "err_pos_percent"),
+                "err_or_percent": _median(g.stats, "err_or_percent"),
+                "failed_other": sum(col_of[t.run_key].label == label for t in other),
+            })
+    for label in {col_of[t.run_key].label for t in other} - {r["method"] for r in rows}:
+        rows.append({"source": "ours", "method": label, "trials": 0, "discarded": 0, "drops_percent": None,
+                     "err_pos_cm": None, "err_pos_percent": None, "err_or_percent": None,
+                     "failed_other": sum(col_of[t.run_key].label == label for t in other)})
+    for method, v in TABLE_II.items():
+        rows.append({"source": "paper", "method": method, **dict(v)})
+    return rows
+
+
+def inhand_table3(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
+    """Per method: per task, median metrics over its trials, with the paper's DMG figures by object."""
+    scored, _ = _scorable(trials)
+    if not scored:
+        return []
+    columns, col_of = _columns(scored)
+    a = _inhand_arrays(scored)
+    s = score_trials(a["initial"], a["desired"], a["reached"], setup=a["setup"], dropped=a["dropped"],
+                     plan_time_s=a["plan_time_s"], exec_time_s=a["exec_time_s"])
+    cols = {
+        "method": np.array([col_of[t.run_key].label for t in scored], dtype=object),
+        "task_id": np.array([t.outcome.get("task_id", "") for t in scored], dtype=object),
+    }
+    objects = {t.outcome.get("task_id", ""): t.outcome.get("object", "") for t in scored}
+    out: list[dict[str, Any]] = []
+    for g in summarize_scores(s, cols, ("method", "task_id"), a["dropped"]):
+        method, task_id = g.key
+        obj = objects.get(task_id, "")
+        ours = {
+            "err_pos_cm": _median(g.stats, "err_pos", 100.0),
+            "err_pos_percent": _median(g.stats, "err_pos_percent"),
+            "err_or_percent": _median(g.stats, "err_or_percent"),
+            "plan_time_s": _median(g.stats, "plan_time_s"),
+        }
+        out.append({
+            "method": method, "task_id": task_id, "object": obj, "trials": g.n_trials,
+            "drops_percent": g.drops_percent, "ours": ours, "paper": dict(TABLE_III.get(obj, {})),
+        })
+    return out
+
+
+
+# -- backend comparison ------------------------------------------------------------------------
+
+
+def compare_backends(runs: Sequence[tuple[str, Sequence[StoredTrial]]], required: int | None) -> dict[str, Any]:
+    """``runs``: (backend, its trials). Per trial and per backend: status, score, cause, sim/wall time."""
+    indices = sorted({t.trial_index for _, rows in runs for t in rows})
+    per_trial = []
+    for i in indices:
+        row: dict[str, Any] = {"trial": i}
+        for backend, rows in runs:
+            t = next((r for r in rows if r.trial_index == i), None)
+            row[backend] = None if t is None else {
+                "status": t.status.value, "score": t.score,
+                "cause": t.failure_cause.value if t.failure_cause else None,
+                "sim_s": t.sim_s, "wall_s": t.wall_s, "message": t.message,
+            }
+        per_trial.append(row)
+    summary = {}
+    for backend, rows in runs:
+        need = required if required is not None else len(indices)
+        cell = rubiks_cell(rows, need) if rows and rows[0].benchmark == "rubiks" else None
+        sims = [t.sim_s for t in rows if t.sim_s is not None]
+        walls = [t.wall_s for t in rows if t.wall_s is not None]
+        summary[backend] = {
+            "trials": len(rows),
+            "successes": sum(t.status is TrialStatus.SUCCESS for t in rows),
+            "completed": None if cell is None else cell.completed,
+            "mean_s": None if cell is None else cell.mean_s,
+            "std_s": None if cell is None else cell.std_s,
+            "causes": dict(Counter(t.failure_cause.value for t in rows if t.failure_cause)),
+            "real_time_factor": (sum(sims) / sum(walls)) if sims and walls and sum(walls) > 0 else None,
+        }
+    return {"trials": per_trial, "summary": summary}

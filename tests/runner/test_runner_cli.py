@@ -1,0 +1,157 @@
+"""The run, table, compare and results commands (invoked directly through click)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import statistics
+
+import numpy as np
+import pytest
+
+from benchharness.cli.run import compare, results, run, table
+
+PLUGIN = "runner_testplugins"  # tests/runner/runner_testplugins.py
+
+
+def backends_wanted() -> set[str] | None:
+    wanted = {b.strip() for b in os.environ.get("BENCHHARNESS_BACKENDS", "").split(",") if b.strip()}
+    return wanted or None
+
+pytestmark = pytest.mark.sim
+
+BASE = ["--robot", "test-stub", "--plugin", PLUGIN, "--workers", "0", "--no-progress"]
+
+
+def _json(result):
+    return json.loads(result.output[result.output.index("{"):])
+
+
+def test_table_shows_hand_computed_mean_and_std_beside_the_paper(invoke):
+    # test-timed makes trial k of Rubiks-5-5 last exactly k simulated seconds after contact
+    r = invoke(run, "--task", "Rubiks-5-5", "--strategy", "test-timed", *BASE, "--json")
+    assert r.exit_code == 0, r.output
+    data = _json(r)
+    assert [t["score"] for t in data["trials"]] == pytest.approx([1, 2, 3, 4, 5])
+    assert data["tier"]["completed"] is True
+    # a failed single-trial tier: not completed
+    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-wrong", *BASE)
+    assert r.exit_code == 1
+    assert "not completed" in r.output
+
+    r = invoke(table)
+    assert r.exit_code == 0
+    mean, std = statistics.fmean([1, 2, 3, 4, 5]), statistics.stdev([1, 2, 3, 4, 5])
+    assert f"{mean:.2f} / {std:.2f}" == "3.00 / 1.58"
+    line = next(ln for ln in r.output.splitlines() if "Rubiks-5-5" in ln)
+    assert "113.35 / 17.16" in line and "113.81 / 18.35" in line and "3.00 / 1.58" in line
+    line = next(ln for ln in r.output.splitlines() if "Rubiks-1-5 " in ln)
+    assert "139.07 / -" in line and "— (0/1)" in line
+    assert "test-timed (test-stub, pybullet)" in r.output
+
+    data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
+    assert [row["tier"] for row in data["rows"]] == ["Rubiks-1-5", "Rubiks-5-5"]
+    ours = data["rows"][1]["ours"]["test-timed (test-stub, pybullet)"]
+    assert ours["mean_s"] == pytest.approx(mean) and ours["std_s"] == pytest.approx(std)
+    assert data["rows"][0]["published"]["Dead reckoning PR2"]["mean_s"] == 139.07
+
+
+def test_partial_tier_is_not_shown_as_a_score(invoke):
+    r = invoke(run, "--task", "Rubiks-5-5", "--strategy", "test-timed", *BASE, "--trials", "1-2")
+    assert r.exit_code == 0
+    line = next(ln for ln in invoke(table).output.splitlines() if "Rubiks-5-5" in ln)
+    assert "… 2/5 run" in line
+
+
+def test_bad_names_exit_2_with_the_plugin_managers_message(invoke):
+    for opt, value, kind in (("--robot", "nope", "robot"), ("--strategy", "nope", "strategy"),
+                             ("--backend", "nope", "backend"), ("--sensors", "a,nope", "sensor")):
+        args = ["--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE]
+        if opt in args:
+            args[args.index(opt) + 1] = value
+        else:
+            args += [opt, value]
+        r = invoke(run, *args)
+        assert r.exit_code == 2, (opt, r.output)
+        assert f"no {kind} named" in r.output and "Available" in r.output
+    r = invoke(run, "--task", "Rubiks-9-9", "--strategy", "test-drop", *BASE)
+    assert r.exit_code == 2 and "no task named 'Rubiks-9-9'" in r.output
+    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--physics", "warp=1")
+    assert r.exit_code == 2 and "unknown physics setting" in r.output
+
+
+def test_results_lists_failures_with_causes(invoke):
+    for strategy in ("test-simerror", "test-jammed", "test-drop"):
+        invoke(run, "--task", "Rubiks-1-5", "--strategy", strategy, *BASE)
+    r = invoke(results, "--failures", "--json", "--traceback")
+    data = _json(r)["trials"]
+    assert sorted(t["failure_cause"] for t in data) == ["jammed", "simulator_error"]
+    assert any("SimulationError" in t["traceback"] for t in data)
+    text = invoke(results).output
+    assert "simulator_error" in text and "jammed" in text and "success" in text
+    assert invoke(results, "--strategy", "test-drop", "--json").output.count('"status": "success"') == 1
+
+
+def test_pose_error_plot(invoke, tmp_path):
+    invoke(run, "--task", "Rubiks-1-10", "--strategy", "test-drop", *BASE)
+    png = tmp_path / "drift.png"
+    r = invoke(results, "--plot-pose-error", str(png))
+    assert r.exit_code == 0, r.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_video_mp4_and_a_clear_error_without_a_camera(invoke, tmp_path):
+    pytest.importorskip("imageio_ffmpeg")
+    mp4 = tmp_path / "trial.mp4"
+    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--video", str(mp4), "--json")
+    assert r.exit_code == 0, r.output
+    info = _json(r)["video"]
+    # the trial lasts ~0.3 simulated s: frames at 30 per simulated second
+    assert 5 <= info["frames"] <= 15 and mp4.stat().st_size > 1000
+    assert mp4.read_bytes()[4:8] == b"ftyp"
+    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backend", "sapien",
+               "--video", str(tmp_path / "x.mp4"))
+    assert r.exit_code == 2 and "has no camera" in r.output
+
+
+def test_gif_video(invoke, tmp_path):
+    gif = tmp_path / "trial.gif"
+    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--video", str(gif))
+    assert r.exit_code == 0 and gif.read_bytes()[:6] == b"GIF89a"
+
+
+def test_inhand_run_and_tables(invoke):
+    r = invoke(run, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "5", *BASE, "--json")
+    trials = _json(r)["trials"]
+    assert len(trials) == 20 and r.exit_code == 1  # some drops
+    drops = sum(t["failure_cause"] == "dropped" for t in trials)
+    data = _json(invoke(table, "--benchmark", "inhand", "--json"))["inhand"]
+    ours = [row for row in data["table2"] if row["source"] == "ours"]
+    assert len(ours) == 1 and ours[0]["trials"] == 20
+    assert ours[0]["drops_percent"] == pytest.approx(100 * drops / 20)
+    scores = [t["score"] for t in trials if t["status"] == "success"]
+    assert ours[0]["err_pos_cm"] == pytest.approx(100 * float(np.median(scores)))
+    assert {row["method"] for row in data["table2"] if row["source"] == "paper"} >= {"relaxed-rigidity"}
+    t3 = data["table3"]
+    assert {row["object"] for row in t3} == {"gelatin box", "cracker box", "spatula", "potted meat can"}
+    assert all(row["paper"]["err_pos_cm"] > 0 for row in t3)
+    text = invoke(table, "--benchmark", "inhand").output
+    assert "relaxed-rigidity" in text and "gelatin box [gelatin_box-dmg2]" in text
+
+
+@pytest.mark.skipif(backends_wanted() is not None and not {"pybullet", "sapien"} <= backends_wanted(),
+                    reason="needs both backends")
+def test_compare_runs_the_tier_on_both_backends(invoke):
+    r = invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backends", "pybullet,sapien",
+               "--json")
+    assert r.exit_code == 0, r.output
+    data = _json(r)
+    assert set(data["summary"]) == {"pybullet", "sapien"}
+    row = data["trials"][0]
+    for b in ("pybullet", "sapien"):
+        assert row[b]["status"] == "success", row[b]
+        assert not math.isnan(row[b]["score"])
+    text = invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE).output
+    assert "pybullet: status" in text and "sapien: status" in text and "real-time factor" in text
+    assert invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backends", "pybullet").exit_code == 2
