@@ -1,0 +1,39 @@
+"""Dexterous Manipulation Graph (DMG) planner for a parallel gripper (Level III).
+
+After Cruciani, Smith, Kragic, Hang, "Dexterous Manipulation Graphs", IROS
+2018, as evaluated in the in-hand benchmark's Table III. The object surface
+is cut into ~1 cm patches; a state is a patch and a gripper angle about its
+normal at which the opposite finger meets the object within the opening, in
+an antipodal pair, and the gripper clears the object; in-hand motions are
+rotations about the contact normal and translations between adjacent
+patches, planned as a shortest path. See ``docs/dmg.md``.
+
+Modules: :mod:`.config` (parameters), :mod:`.patches` (surface
+discretisation), :mod:`.graph` (construction, "DMG time"), :mod:`.planner`
+(queries, "Plan time"), :mod:`.placement` (published data on our meshes),
+:mod:`.runner` (the strategy object, results files). Importing this package
+is cheap: trimesh/networkx load inside the factory's products.
+"""
+
+from __future__ import annotations
+
+from benchharness.plugin import Registration
+
+__all__ = ["REGISTRATIONS", "make_planner"]
+
+
+def make_planner(**kwargs):
+    """Strategy factory: a :class:`~.runner.DMGPlanner` (keyword arguments pass through)."""
+    from .runner import DMGPlanner
+
+    return DMGPlanner(**kwargs)
+
+
+REGISTRATIONS = [
+    Registration(
+        "dmg",
+        make_planner,
+        "Dexterous Manipulation Graph planner (parallel gripper, Level III)",
+        {"levels": [3], "hand": "parallel gripper (YuMi smart gripper)"},
+    )
+]
