@@ -1,0 +1,59 @@
+"""The README's console examples run and print what the README shows.
+
+Every ``$ benchharness ...`` line in a ```console block of the protocol,
+scoring and plugin sections is run from the repository root; each output line
+the README shows under it (other than ``...``) must appear in the real
+output, and an example whose shown output starts with ``error:`` must exit 2
+(bad input). Simulation examples (``run``, ``compare``, ``--backend``) and
+those writing files or naming the user's own files are left to their own
+tests.
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SKIP = ("--backend", " run ", " compare ", "--plot", "--png", "my_results", " results")
+
+
+def examples() -> list[tuple[str, list[str]]]:
+    text = (ROOT / "README.md").read_text()
+    out: list[tuple[str, list[str]]] = []
+    for block in re.findall(r"```console\n(.*?)```", text, flags=re.S):
+        current: tuple[str, list[str]] | None = None
+        for line in block.splitlines():
+            if line.startswith("$ "):
+                cmd = line[2:].split("  #")[0].strip()
+                current = (cmd, [])
+                out.append(current)
+            elif current is not None and line.strip() and line.strip() != "...":
+                current[1].append(line.rstrip())
+    return [(c, e) for c, e in out if not any(s in f" {c} " for s in SKIP)]
+
+
+@pytest.mark.parametrize("command,expected", examples(), ids=[c for c, _ in examples()])
+def test_readme_example(command, expected):
+    argv = shlex.split(command)
+    assert argv[0] == "benchharness"
+    proc = subprocess.run(
+        [sys.executable, "-m", "benchharness.cli.main", *argv[1:]],
+        capture_output=True, text=True, cwd=ROOT, timeout=300,
+    )
+    output = proc.stdout + proc.stderr
+    if expected and expected[0].startswith("error:"):
+        assert proc.returncode == 2, output
+    else:
+        assert proc.returncode == 0, output
+    for line in expected:
+        assert line in output, f"README shows {line!r}; got:\n{output}"
+
+
+def test_there_are_examples():
+    assert len(examples()) >= 8
