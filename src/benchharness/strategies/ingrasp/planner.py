@@ -1,0 +1,261 @@
+"""Kinematic trajectory optimisation for in-grasp manipulation (Level I).
+
+Decision variables: the used fingers' joints at T waypoints after the fixed
+initial grasp. The object is not simulated: it is a frame rigidly attached
+to a carrier frame computed from the fingertips (the fingertip triangle, or
+the reference fingertip as in the original; the pose at the initial grasp
+fixes the offset), so the object pose at every waypoint is forward
+kinematics. Variants differ in how the fingertips are kept on the object
+(see ``docs/ingrasp.md``):
+
+* ``relaxed-rigidity``: each fingertip is modelled as rigidly attached too,
+  and the disagreement between where it would put the object and where the
+  carrier puts it (position and orientation) is a cost;
+* ``relaxed-position``: the fingertip's position in the object frame may
+  change at a cost;
+* ``relaxed-position-orientation``: as relaxed-position plus, as a separate
+  term, the fingertip's orientation relative to the object;
+* ``ik-rigid``: the object follows a path interpolated from the initial to
+  the goal pose and every fingertip (reference included) must keep its
+  initial pose in the object frame (heavily weighted, i.e. constraints) --
+  over-constrained with 4-joint fingers;
+* ``point-contact``: as ik-rigid but only the fingertip positions are held
+  (point contact with friction: orientation free); the object pose is
+  recovered afterwards by a least-squares fit of the contacts.
+
+The optimiser is L-BFGS on the weighted sum of squared residuals (gradients
+by torch autograd through the fingertip FK). Joint and per-step velocity
+limits are penalty residuals during the optimisation and are then
+enforced exactly by projecting the trajectory (clamping waypoint by
+waypoint), so the returned trajectory always satisfies them.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from .config import OBJECT_PATH, RELAXED, VARIANTS, IngraspConfig
+from .hand import DTYPE, FINGERS, HandKinematics
+from .problem import InGraspProblem
+from .rotations import interpolate_poses, inverse, pose_vector, rot_residual
+
+__all__ = ["PlanResult", "plan", "object_poses", "project_trajectory", "fit_object_pose"]
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A planned trajectory and what it implies for the object."""
+
+    variant: str
+    fingers: tuple[str, ...]
+    q: np.ndarray  #: (T + 1, 4 k) joints of the used fingers, row 0 = initial grasp
+    q_hand: np.ndarray  #: (T + 1, 16) whole hand (unused fingers hold the initial grasp)
+    object_final: np.ndarray  #: 4x4 planned object pose in the palm frame at the last waypoint
+    goal: np.ndarray  #: 4x4 desired object pose in the palm frame
+    reached: np.ndarray  #: (7,) planned pose ``[x, y, z, qx, qy, qz, qw]`` in the dataset's convention
+    plan_time_s: float  #: wall time of the optimisation (set-up of the hand model excluded)
+    converged: bool  #: stopped on the tolerances, not on the iteration budget
+    iterations: int
+    cost: float  #: final cost (before projection)
+    pos_error: float  #: m, planned vs goal object position
+    rot_error: float  #: rad, planned vs goal object orientation
+    projection_change: float  #: rad, largest joint change made by the final limit projection
+
+
+def carrier_frames(tips: torch.Tensor, object_frame: str) -> torch.Tensor:
+    """The frame the object is attached to, from fingertip poses (B, k, 4, 4) -> (B, 4, 4).
+
+    ``reference-finger``: the first fingertip's frame. ``fingertips``: the
+    triangle of the first three fingertip positions (origin at the centroid,
+    x along tip 0 -> tip 1, z along the triangle normal), which moves with
+    all three fingers, so the object has as many degrees of freedom as a
+    rigid body instead of the reference finger's four.
+    """
+    if object_frame == "reference-finger":
+        return tips[:, 0]
+    if tips.shape[1] < 3:
+        raise ValueError("object_frame='fingertips' needs at least three fingers")
+    p = tips[:, :3, :3, 3]
+    x = p[:, 1] - p[:, 0]
+    x = x / x.norm(dim=-1, keepdim=True)
+    z = torch.linalg.cross(x, p[:, 2] - p[:, 0])
+    z = z / z.norm(dim=-1, keepdim=True)
+    y = torch.linalg.cross(z, x)
+    top = torch.cat([torch.stack([x, y, z], dim=-1), p.mean(dim=1)[..., None]], dim=-1)
+    return torch.cat([top, tips[:, 0, 3:4, :]], dim=-2)
+
+
+def object_poses(hand: HandKinematics, problem: InGraspProblem, q: torch.Tensor,
+                 object_frame: str = "reference-finger") -> torch.Tensor:
+    """Object frame implied by the fingertips for joint rows ``q`` (B, 4 k) -> (B, 4, 4)."""
+    q0 = torch.as_tensor(problem.q0, dtype=DTYPE)[None]
+    c0 = carrier_frames(hand.tip_poses(q0, problem.fingers), object_frame)[0]
+    attach = inverse(c0) @ torch.as_tensor(problem.object_initial, dtype=DTYPE)
+    return carrier_frames(hand.tip_poses(q, problem.fingers), object_frame) @ attach
+
+
+def project_trajectory(q: np.ndarray, q0: np.ndarray, lower: np.ndarray, upper: np.ndarray, max_step: float) -> np.ndarray:
+    """Nearest-by-clamping trajectory within joint limits and the per-step bound (rows after ``q0``).
+
+    Clamping waypoint by waypoint is always feasible because each clamped
+    waypoint is itself within the limits.
+    """
+    out = np.empty_like(q)
+    prev = np.asarray(q0, float)
+    for t in range(q.shape[0]):
+        lo = np.maximum(lower, prev - max_step)
+        hi = np.minimum(upper, prev + max_step)
+        out[t] = np.clip(q[t], lo, hi)
+        prev = out[t]
+    return out
+
+
+def fit_object_pose(points_obj: np.ndarray, points_palm: np.ndarray) -> np.ndarray:
+    """Rigid transform (4x4) best mapping object-frame contacts onto palm-frame fingertips (Kabsch)."""
+    a, b = np.asarray(points_obj, float), np.asarray(points_palm, float)
+    ca, cb = a.mean(0), b.mean(0)
+    u, _, vt = np.linalg.svd((a - ca).T @ (b - cb))
+    d = np.sign(np.linalg.det(vt.T @ u.T))
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = r, cb - r @ ca
+    return m
+
+
+class _Cost:
+    """The variant's cost as a function of the waypoint block (T, 4 k)."""
+
+    def __init__(self, hand: HandKinematics, problem: InGraspProblem, variant: str, cfg: IngraspConfig) -> None:
+        self.hand, self.p, self.variant, self.cfg = hand, problem, variant, cfg
+        t = lambda a: torch.as_tensor(np.asarray(a, float), dtype=DTYPE)  # noqa: E731
+        self.q0 = t(problem.q0)
+        lo, hi = hand.limits(problem.fingers)
+        self.lo, self.hi = t(lo + cfg.limit_margin), t(hi - cfg.limit_margin)
+        self.goal = t(problem.goal)
+        x0 = hand.tip_poses(self.q0[None], problem.fingers)[0]  # (k, 4, 4)
+        self.x_o0 = t(problem.object_initial)
+        self.attach = inverse(carrier_frames(x0[None], cfg.object_frame)[0]) @ self.x_o0  # object in its carrier frame
+        rel = inverse(self.x_o0)[None] @ x0  # fingertips in the object frame (k, 4, 4)
+        self.tip_in_obj = rel
+        self.obj_in_tip = inverse(x0) @ self.x_o0[None]  # object in each fingertip frame
+        if variant in OBJECT_PATH:
+            s = np.arange(1, cfg.waypoints + 1) / cfg.waypoints
+            path = interpolate_poses(problem.object_initial, problem.goal, s)  # (T, 4, 4)
+            self.targets = t(path)[:, None] @ rel[None]  # (T, k, 4, 4)
+
+    def residuals(self, q: torch.Tensor) -> torch.Tensor:
+        """All weighted residuals as one vector; the cost is its squared norm (a least-squares problem)."""
+        cfg, v = self.cfg, self.variant
+        sq = lambda w, r: (w ** 0.5) * r.reshape(-1)  # noqa: E731
+        x = self.hand.tip_poses(q, self.p.fingers)  # (T, k, 4, 4)
+        parts = []
+        if v in RELAXED:
+            x_o = carrier_frames(x, cfg.object_frame) @ self.attach  # (T, 4, 4)
+            first = 1 if cfg.object_frame == "reference-finger" else 0  # the carrier finger cannot slip
+            others = x[:, first:]
+            if v == "relaxed-rigidity":
+                pred = others @ self.obj_in_tip[None, first:]  # object as each fingertip would carry it
+                parts.append(sq(cfg.w_rigid_pos, pred[..., :3, 3] - x_o[:, None, :3, 3]))
+                parts.append(sq(cfg.w_rigid_rot, rot_residual(x_o[:, None, :3, :3], pred[..., :3, :3])))
+            else:
+                in_obj = inverse(x_o)[:, None] @ others  # fingertips in the object frame now
+                parts.append(sq(cfg.w_rigid_pos, in_obj[..., :3, 3] - self.tip_in_obj[None, first:, :3, 3]))
+                if v == "relaxed-position-orientation":
+                    parts.append(sq(cfg.w_rigid_rot, rot_residual(self.tip_in_obj[None, first:, :3, :3], in_obj[..., :3, :3])))
+            xf = x_o[-1]
+            parts.append(sq(cfg.w_goal_pos, xf[:3, 3] - self.goal[:3, 3]))
+            parts.append(sq(cfg.w_goal_rot, rot_residual(self.goal[:3, :3], xf[:3, :3])))
+        else:
+            parts.append(sq(cfg.w_contact_pos, x[..., :3, 3] - self.targets[..., :3, 3]))
+            if v == "ik-rigid":
+                parts.append(sq(cfg.w_contact_rot, rot_residual(self.targets[..., :3, :3], x[..., :3, :3])))
+        steps = torch.diff(torch.cat([self.q0[None], q]), dim=0)
+        parts.append(sq(cfg.w_smooth, steps))
+        parts.append(sq(cfg.w_limits, torch.relu(q - self.hi) + torch.relu(self.lo - q)))
+        parts.append(sq(cfg.w_limits, torch.relu(steps.abs() - cfg.max_step)))
+        return torch.cat(parts)
+
+    def __call__(self, q: torch.Tensor) -> torch.Tensor:
+        return (self.residuals(q) ** 2).sum()
+
+
+def _lbfgs(cost: _Cost, init: torch.Tensor, cfg: IngraspConfig) -> tuple[torch.Tensor, bool, int, float]:
+    """Minimise the cost from ``init`` with L-BFGS (strong-Wolfe line search).
+
+    Runs in calls of ``inner_iterations`` and stops when a call lowered the
+    cost by less than ``ftol`` (relative) or the gradient is below ``gtol``
+    (converged), or when ``max_iterations`` are spent (not converged: the
+    budget is set for planning time, and the goal error is usually settled
+    long before the slip/smoothness trade-off is).
+    """
+    z = init.clone().requires_grad_(True)
+    opt = torch.optim.LBFGS([z], lr=1.0, max_iter=cfg.inner_iterations, history_size=20,
+                            line_search_fn="strong_wolfe", tolerance_grad=cfg.gtol, tolerance_change=1e-14)
+
+    def closure():
+        opt.zero_grad()
+        c = cost(z)
+        c.backward()
+        return c
+
+    converged, prev, iters = False, None, 0
+    while iters < cfg.max_iterations:
+        opt.step(closure)
+        iters = int(opt.state[z].get("n_iter", iters + cfg.inner_iterations))
+        with torch.no_grad():
+            cur = float(cost(z))
+        if z.grad is not None and float(z.grad.abs().max()) <= cfg.gtol:
+            converged = True
+            break
+        if prev is not None and prev - cur <= cfg.ftol * max(1.0, abs(cur)):
+            converged = True
+            break
+        prev = cur
+    with torch.no_grad():
+        final = float(cost(z))
+    return z.detach(), converged, iters, final
+
+
+def plan(hand: HandKinematics, problem: InGraspProblem, variant: str = "relaxed-rigidity",
+         config: IngraspConfig = IngraspConfig()) -> PlanResult:
+    """Optimise a joint trajectory for ``problem`` with ``variant``; deterministic for a given ``config.seed``."""
+    if variant not in VARIANTS:
+        raise ValueError(f"unknown variant {variant!r}; one of {', '.join(VARIANTS)}")
+    cfg = config
+    start = time.perf_counter()
+    cost_fn = _Cost(hand, problem, variant, cfg)
+    gen = torch.Generator().manual_seed(cfg.seed)
+    init = cost_fn.q0[None].repeat(cfg.waypoints, 1)
+    init = init + cfg.init_noise * torch.randn(init.shape, generator=gen, dtype=DTYPE)
+    z, converged, iters, final_cost = _lbfgs(cost_fn, init, cfg)
+    q_opt = z.detach().numpy()
+    lo, hi = hand.limits(problem.fingers)
+    q_proj = project_trajectory(q_opt, problem.q0, lo + cfg.limit_margin, hi - cfg.limit_margin, cfg.max_step)
+    q_all = np.vstack([problem.q0[None], q_proj])
+    obj = _planned_object(hand, problem, variant, q_all[-1], cfg.object_frame)
+    elapsed = time.perf_counter() - start
+    q_hand = np.tile(problem.q_rest, (q_all.shape[0], 1))
+    for i, f in enumerate(problem.fingers):
+        j = FINGERS.index(f)
+        q_hand[:, 4 * j: 4 * j + 4] = q_all[:, 4 * i: 4 * i + 4]
+    dp = float(np.linalg.norm(obj[:3, 3] - problem.goal[:3, 3]))
+    rel = problem.goal[:3, :3].T @ obj[:3, :3]
+    dr = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
+    return PlanResult(variant, problem.fingers, q_all, q_hand, obj, problem.goal.copy(), pose_vector(obj), elapsed,
+                      converged, iters, final_cost, dp, dr, float(np.abs(q_proj - q_opt).max()))
+
+
+def _planned_object(hand: HandKinematics, problem: InGraspProblem, variant: str, q_last: np.ndarray,
+                    object_frame: str) -> np.ndarray:
+    """Object pose the plan implies: reference-finger attachment, or a contact fit for point-contact."""
+    if variant == "point-contact":
+        x0 = hand.tip_poses_np(problem.q0[None], problem.fingers)[0]
+        c_obj = (np.linalg.inv(problem.object_initial)[None] @ x0)[:, :3, 3]
+        x = hand.tip_poses_np(q_last[None], problem.fingers)[0]
+        return fit_object_pose(c_obj, x[:, :3, 3])
+    with torch.no_grad():
+        return object_poses(hand, problem, torch.as_tensor(q_last[None], dtype=DTYPE), object_frame)[0].numpy()

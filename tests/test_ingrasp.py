@@ -1,0 +1,167 @@
+"""In-grasp trajectory optimisation (benchharness.strategies.ingrasp), Level I on the Allegro."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+
+from benchharness.strategies.ingrasp.config import VARIANTS, IngraspConfig
+from benchharness.strategies.ingrasp.hand import DTYPE, FINGERS, HandKinematics
+from benchharness.strategies.ingrasp.planner import object_poses, plan, project_trajectory
+from benchharness.strategies.ingrasp.problem import problem_from_task
+from benchharness.strategies.ingrasp.rotations import pose_matrix
+from benchharness.strategies.ingrasp.tasks import published_tasks
+
+
+@pytest.fixture(scope="module")
+def hand():
+    torch.set_num_threads(1)
+    return HandKinematics()
+
+
+@pytest.fixture(scope="module")
+def tasks():
+    return published_tasks()
+
+
+def test_fast_fk_matches_pytorch_kinematics(hand):
+    q = torch.rand(20, 16, generator=torch.Generator().manual_seed(3), dtype=DTYPE) * 1.4 - 0.2
+    assert torch.allclose(hand.tip_poses(q, FINGERS), hand.tip_poses_pk(q, FINGERS), atol=1e-12)
+
+
+def test_fk_gradient_matches_finite_differences(hand):
+    """Autograd through the fingertip FK agrees with central differences (per joint, all fingers)."""
+    q = torch.tensor([0.1, 0.4, 0.9, 0.7, -0.1, 0.5, 0.8, 0.6, 0.0, 0.3, 0.3, 0.3, 1.0, 0.4, 0.6, 0.9], dtype=DTYPE)
+    w = torch.randn(4, 4, 4, generator=torch.Generator().manual_seed(1), dtype=DTYPE)  # random linear functional
+
+    def f(x):
+        return (hand.tip_poses(x[None], FINGERS)[0] * w).sum()
+
+    x = q.clone().requires_grad_(True)
+    f(x).backward()
+    h = 1e-6
+    fd = torch.stack([(f(q + h * e) - f(q - h * e)) / (2 * h) for e in torch.eye(16, dtype=DTYPE)])
+    assert torch.allclose(x.grad, fd, rtol=1e-6, atol=1e-8)
+
+
+def test_published_tasks_and_goal_convention(tasks, hand):
+    assert len(tasks) == 100 and all(t.fingers == ("index", "middle", "thumb") for t in tasks)
+    t = tasks[0]
+    p = problem_from_task(t, hand)
+    # H_d^rob = (H_d H_i^-1) H_i^rob with H_i^rob = H_i is H_d itself
+    assert np.allclose(p.goal, pose_matrix(t.desired), atol=1e-12)
+    assert np.allclose(p.object_initial, pose_matrix(t.initial))
+    # the published thumb rotation (1.6 rad) is beyond our joint_12 limit (1.396) and is clamped
+    assert "joint_12" in p.clamped and p.q_rest[12] == pytest.approx(hand.limits(("thumb",))[1][0])
+    # the object frame implied by the fingertips at the initial grasp is the initial pose
+    for frame in ("fingertips", "reference-finger"):
+        x = object_poses(hand, p, torch.as_tensor(p.q0[None], dtype=DTYPE), frame)[0].numpy()
+        assert np.allclose(x, p.object_initial, atol=1e-12)
+
+
+def _synthetic(hand, tasks, delta):
+    """A problem whose goal is the object pose produced by a known joint change (reachable by construction)."""
+    base = problem_from_task(tasks[0], hand)
+    lo, hi = hand.limits(base.fingers)
+    q_goal = np.clip(base.q0 + delta, lo, hi)
+    with torch.no_grad():
+        goal = object_poses(hand, base, torch.as_tensor(q_goal[None], dtype=DTYPE), "fingertips")[0].numpy()
+    return replace(base, goal=goal), q_goal
+
+
+def test_relaxed_rigidity_reaches_a_reachable_goal(hand, tasks):
+    delta = np.array([0.1, -0.3, 0.3, 0.1, 0.1, -0.3, 0.3, 0.1, 0.0, -0.2, 0.2, -0.2])  # 1.7 cm, 11 deg
+    prob, _ = _synthetic(hand, tasks, delta)
+    moved = np.linalg.norm(prob.goal[:3, 3] - prob.object_initial[:3, 3])
+    assert moved > 0.01  # a real motion, not a no-op
+    r = plan(hand, prob, "relaxed-rigidity")
+    assert r.pos_error < 1.0e-3  # 1 mm
+    assert np.degrees(r.rot_error) < 0.5
+
+
+def test_ik_rigid_is_over_constrained(hand, tasks):
+    """Paper, Fig. 6: IK-rigid has difficulty reaching the goal; relaxed-rigidity does not.
+
+    Measured on all 100 tasks (docs/benchmarks/ingrasp.md): ik-rigid's planned
+    position error is larger than relaxed-rigidity's on 96, and larger than
+    twice it plus 2 mm on 78; asserted here on three tasks spread over objects.
+    """
+    for t in (tasks[0], tasks[46], tasks[92]):
+        p = problem_from_task(t, hand)
+        rr, ik = plan(hand, p, "relaxed-rigidity"), plan(hand, p, "ik-rigid")
+        assert ik.pos_error > 2.0 * rr.pos_error + 2e-3, t.task_id
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_joint_and_step_limits_respected(hand, tasks, variant):
+    # a tight speed limit and a far goal make the limits bind
+    cfg = IngraspConfig(max_joint_speed=0.3, max_iterations=50)
+    p = problem_from_task(tasks[3], hand)
+    r = plan(hand, p, variant, cfg)
+    lo, hi = hand.limits(p.fingers)
+    assert r.q.shape == (cfg.waypoints + 1, 12) and np.array_equal(r.q[0], p.q0)
+    assert np.all(r.q >= lo - 1e-12) and np.all(r.q <= hi + 1e-12)
+    assert np.abs(np.diff(r.q, axis=0)).max() <= cfg.max_step + 1e-12
+    # unused fingers (ring) hold the initial grasp
+    assert np.all(r.q_hand[:, 8:12] == p.q_rest[8:12])
+
+
+def test_projection_enforces_limits_exactly():
+    q0 = np.zeros(2)
+    q = np.array([[1.0, -1.0], [2.0, 0.5], [-3.0, 0.5]])
+    out = project_trajectory(q, q0, np.array([-0.5, -0.5]), np.array([0.5, 0.5]), 0.3)
+    assert np.allclose(out, [[0.3, -0.3], [0.5, 0.0], [0.2, 0.3]])
+
+
+def test_same_seed_same_trajectory(hand, tasks):
+    p = problem_from_task(tasks[10], hand)
+    cfg = IngraspConfig(max_iterations=50)
+    a, b = plan(hand, p, "relaxed-position", cfg), plan(hand, p, "relaxed-position", cfg)
+    assert np.array_equal(a.q, b.q) and np.array_equal(a.reached, b.reached)
+    c = plan(hand, p, "relaxed-position", replace(cfg, seed=1))
+    assert not np.array_equal(a.q, c.q)  # the seed does reach the optimiser
+
+
+def test_results_file_round_trips_through_score_cli(hand, tasks, tmp_path):
+    from click.testing import CliRunner
+
+    from benchharness.cli.main import cli
+    from benchharness.metrics.pose import err_pos
+    from benchharness.strategies.ingrasp.results import write_plan_results
+
+    cfg = IngraspConfig(max_iterations=50)
+    sel = [tasks[0], tasks[50]]
+    plans, rows = [], []
+    for v in ("relaxed-rigidity", "ik-rigid"):
+        for t in sel:
+            plans.append(plan(hand, problem_from_task(t, hand), v, cfg))
+            rows.append(t)
+    path = write_plan_results(tmp_path / "plans.csv", rows, plans, cfg)
+    r = CliRunner().invoke(cli, ["inhand", "score", str(path), "--json"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.output)
+    groups = {g["key"]["method"]: g for g in data["groups"]}
+    assert set(groups) == {"relaxed-rigidity", "ik-rigid"} and data["n_trials"] == 4
+    for v, g in groups.items():
+        mine = [err_pos(t.desired[:3], p.reached[:3]) * 100 for t, p in zip(rows, plans) if p.variant == v]
+        assert g["metrics"]["err_pos"]["median"] == pytest.approx(np.median(mine), rel=1e-9)
+        # the planned error the optimiser reports is the one the file scores
+        assert np.median([p.pos_error for p in plans if p.variant == v]) * 100 == pytest.approx(np.median(mine), rel=1e-6)
+        assert g["metrics"]["plan_time_s"]["n"] == 2
+
+
+def test_registered_as_strategies(hand, tasks):
+    from benchharness.plugin import get_manager
+
+    m = get_manager()
+    for v in VARIANTS:
+        assert v in m.names("strategy")
+    planner = m.create("strategy", "point-contact", hand=hand, max_iterations=30)
+    r = planner.plan_task(tasks[0])
+    assert r.variant == "point-contact" and r.iterations >= 1
+    with pytest.raises(ValueError):
+        IngraspConfig(object_frame="palm")
