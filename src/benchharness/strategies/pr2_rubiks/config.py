@@ -1,0 +1,103 @@
+"""Parameters of the PR2 Rubik's baselines: scene, grasp geometry and every error source.
+
+Every magnitude is a named field with its default and why (DESIGN.md,
+"Error sources a simulation must model"). ``zero_error()`` gives the same
+configuration with every injected error set to 0 (for tests and for telling
+the strategy's own mistakes from injected ones).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+__all__ = ["ErrorConfig", "PR2RubiksConfig"]
+
+
+@dataclass(frozen=True)
+class ErrorConfig:
+    """Injected errors, each drawn from the strategy's ``ctx.rng``.
+
+    * **Arm calibration offset** (per arm, fixed for the trial): the arm
+      reaches ``offset * commanded`` instead of ``commanded``; a real PR2's
+      arm-to-head kinematic calibration is good to a few mm.
+    * **Actuator tracking noise** (per motion): each commanded tool pose is
+      perturbed by an independent Gaussian translation. Dead reckoning never
+      sees it, so it accumulates as a random walk over regrasps.
+    * **Camera noise**: the head camera's one-shot estimate of the cube on the
+      table; ``benchharness.sensors.HeadCameraConfig`` defaults when that
+      package is importable (4 mm xy, 2 mm z, 3° yaw, 1° tilt), else the
+      figures below.
+    """
+
+    #: std of each arm's fixed calibration offset, per world axis (m). 1.5 mm: a few-mm calibrated PR2.
+    calib_pos_std: float = 0.0015
+    #: std of each arm's fixed calibration rotation, per world axis (deg).
+    calib_rot_std_deg: float = 0.5
+    #: std of the per-motion tracking error of a commanded tool pose, per world axis (m).
+    #: 1 mm: a PR2 arm's repeatability under its PD control is of that order.
+    tracking_std: float = 0.001
+    #: fallback camera noise when benchharness.sensors is absent: position std (m), yaw std (deg)
+    camera_pos_std: float = 0.003
+    camera_yaw_std_deg: float = 2.0
+    #: use the head camera at all (False = the initial estimate is the true pose)
+    camera: bool = True
+
+    def zero(self) -> "ErrorConfig":
+        return ErrorConfig(**{f.name: (False if f.name == "camera" else 0.0) for f in fields(self)})
+
+    @property
+    def is_zero(self) -> bool:
+        return not self.camera and all(getattr(self, f.name) == 0.0 for f in fields(self) if f.name != "camera")
+
+
+@dataclass(frozen=True)
+class PR2RubiksConfig:
+    """Scene, grasp geometry and motion settings of the PR2 baselines (metres, seconds)."""
+
+    #: height of the table top (m): below the PR2's home grippers (0.79 m) so that a side grasp
+    #: of the cube's middle (0.7285 m) is a short reach down.
+    table_height: float = 0.70
+    #: half extents (x, y) of the table top (m): narrow in y (a pedestal) so that a side grasp's
+    #: wrist (18 cm behind the tool frame, 3.5 cm radius) passes beside it, not through it.
+    table_half_size: tuple[float, float] = (0.10, 0.06)
+    #: cube centre on the table in the robot base frame (x forward, y left): the workspace centre.
+    cube_xy: tuple[float, float] = (0.60, 0.0)
+    #: where the cube is held for twisting (cube centre, robot base frame).
+    twist_position: tuple[float, float, float] = (0.60, 0.0, 0.80)
+    #: distance from the cube centre to the tool frame along the work axis for a grip
+    #: `depth` slabs deep. The 35 mm pad is centred on the tool frame, so its inner end sits
+    #: `offset - 17.5 mm` from the centre. Holder 17.5 mm -> inner end at 0: on the middle slab
+    #: (-9.5..9.5 mm) with half a cubie (9.5 mm) of margin either way, the paper's tolerance.
+    #: Rotator 34 mm -> inner end at 16.5 mm: 7 mm clear of the middle slab, 12 mm of the outer
+    #: slab under the pad.
+    rotator_offset: float = 0.034
+    holder_offset: float = 0.0175
+    #: stand-off of the pre-grasp pose along the approach (m).
+    pregrasp_distance: float = 0.07
+    #: stand-off the arm swings round at before a pre-grasp (m): the fingers open to 90 mm and a
+    #: swing of the wrist at 7 cm can sweep the 57 mm cube.
+    far_distance: float = 0.15
+    #: grip force per finger (N), as in tests/cube_physics/rig.py and DESIGN.md.
+    grip_force: float = 20.0
+    #: duration of one quarter turn of the wrist (s).
+    quarter_turn_s: float = 1.0
+    #: joint-speed fraction for arm motions.
+    velocity_scale: float = 0.4
+    #: waypoints (per quarter turn) when the giver turns the cube in a hand-over.
+    handover_waypoints: int = 4
+    #: largest joint change (rad) allowed between two hand-over waypoints when choosing the giver's grip
+    #: (a bigger one means IK flipped the arm round a bounded roll joint).
+    max_waypoint_jump: float = 2.5
+    #: a motion that ends farther than this from its target counts as unreachable (m).
+    reach_tolerance: float = 0.01
+    #: the cube counts as dropped if it ends farther than this from where it is believed (m).
+    drop_distance: float = 0.05
+    #: pick approaches the planner may use (only "side" is implemented physically).
+    pick_approaches: tuple[str, ...] = ("side",)
+    #: stop after this many plan actions (None: the whole plan); the outcome is then the state so far.
+    #: For tests and debugging (e.g. 1 = the pick only).
+    max_actions: int | None = None
+    errors: ErrorConfig = ErrorConfig()
+
+    def zero_error(self) -> "PR2RubiksConfig":
+        return replace(self, errors=self.errors.zero())
