@@ -322,11 +322,12 @@ class PyBulletBackend(Backend):
         shapes = list(shapes)
         mp: MassProperties = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         tmp: list[str] = []
+        arrays = self._shape_arrays(shapes, tmp)  # mesh hulls are written to disk once, here
         if len(shapes) == 1:
             col = pb.createCollisionShape(**self._shape_args(shapes[0], tmp), physicsClientId=cid)
         else:  # one single-link multibody; several shapes become one compound collision shape
-            col = self._compound(shapes, tmp)
-        vis = self._visuals(shapes, tmp)
+            col = self._compound(arrays)
+        vis = self._visuals(arrays)
         m = 0.0 if fixed else float(mass)
         uid = pb.createMultiBody(
             baseMass=m,
@@ -351,42 +352,42 @@ class PyBulletBackend(Backend):
             pb.changeVisualShape(uid, -1, rgbaColor=[0.45, 0.5, 0.6, 1], physicsClientId=cid)
         return self._register(_Body(uid, name or "", None, {}, [], [], mp.inertial_pose, fixed, temp_files=tmp))
 
-    def _compound(self, shapes: list[Shape], tmp: list[str]) -> int:
-        cid = self._cid
-        types, half, radii, lengths, poss, orns = [], [], [], [], [], []
-        files, scales = [], []
+    def _shape_arrays(self, shapes: list[Shape], tmp: list[str]) -> tuple[list, ...]:
+        """Per-shape fields for PyBullet's ``create*ShapeArray`` calls (collision and visual alike).
+
+        Returns ``(types, half_extents, radii, lengths, file_names, positions, orientations)``.
+        """
+        types, half, radii, lengths, files, poss, orns = [], [], [], [], [], [], []
         for s in shapes:
-            files.append(self._hull_obj(s, tmp) if isinstance(s, MeshShape) else "")
-            scales.append([1, 1, 1])
             if isinstance(s, MeshShape):
-                types.append(pb.GEOM_MESH); half.append([0, 0, 0]); radii.append(0); lengths.append(0)
+                fields = (pb.GEOM_MESH, [0, 0, 0], 0.0, 0.0, self._hull_obj(s, tmp))
             elif isinstance(s, Box):
-                types.append(pb.GEOM_BOX); half.append(list(map(float, s.half_extents))); radii.append(0); lengths.append(0)
+                fields = (pb.GEOM_BOX, list(map(float, s.half_extents)), 0.0, 0.0, "")
             elif isinstance(s, Sphere):
-                types.append(pb.GEOM_SPHERE); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(0)
+                fields = (pb.GEOM_SPHERE, [0, 0, 0], float(s.radius), 0.0, "")
             elif isinstance(s, Cylinder):
-                types.append(pb.GEOM_CYLINDER); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(2 * float(s.half_length))
-            poss.append(s.pose.p.tolist()); orns.append(s.pose.q.tolist())
+                fields = (pb.GEOM_CYLINDER, [0, 0, 0], float(s.radius), 2.0 * float(s.half_length), "")
+            else:
+                raise BackendError(f"unknown shape {type(s).__name__}")
+            for column, value in zip((types, half, radii, lengths, files), fields):
+                column.append(value)
+            poss.append(s.pose.p.tolist())
+            orns.append(s.pose.q.tolist())
+        return types, half, radii, lengths, files, poss, orns
+
+    def _compound(self, arrays: tuple[list, ...]) -> int:
+        cid = self._cid
+        types, half, radii, lengths, files, poss, orns = arrays
+        scales = [[1, 1, 1]] * len(types)
         return pb.createCollisionShapeArray(
             shapeTypes=types, halfExtents=half, radii=radii, lengths=lengths,
             fileNames=files, meshScales=scales,
             collisionFramePositions=poss, collisionFrameOrientations=orns, physicsClientId=cid,
         )
 
-    def _visuals(self, shapes: list[Shape], tmp: list[str]) -> int:
+    def _visuals(self, arrays: tuple[list, ...]) -> int:
         """Grey visual shapes mirroring the collision shapes (only the renderer sees them)."""
-        types, half, radii, lengths, files, poss, orns = [], [], [], [], [], [], []
-        for s in shapes:
-            files.append(self._hull_obj(s, tmp) if isinstance(s, MeshShape) else "")
-            if isinstance(s, MeshShape):
-                types.append(pb.GEOM_MESH); half.append([0, 0, 0]); radii.append(0); lengths.append(0)
-            elif isinstance(s, Box):
-                types.append(pb.GEOM_BOX); half.append(list(map(float, s.half_extents))); radii.append(0); lengths.append(0)
-            elif isinstance(s, Sphere):
-                types.append(pb.GEOM_SPHERE); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(0)
-            else:
-                types.append(pb.GEOM_CYLINDER); half.append([0, 0, 0]); radii.append(float(s.radius)); lengths.append(2 * float(s.half_length))
-            poss.append(s.pose.p.tolist()); orns.append(s.pose.q.tolist())
+        types, half, radii, lengths, files, poss, orns = arrays
         try:
             return pb.createVisualShapeArray(
                 shapeTypes=types, halfExtents=half, radii=radii, lengths=lengths, fileNames=files,
