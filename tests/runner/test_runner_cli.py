@@ -155,3 +155,29 @@ def test_compare_runs_the_tier_on_both_backends(invoke):
     text = invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE).output
     assert "pybullet: status" in text and "sapien: status" in text and "real-time factor" in text
     assert invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backends", "pybullet").exit_code == 2
+
+
+def test_inhand_figure7_plot_and_compare_summary(invoke, tmp_path):
+    r = invoke(run, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "3", *BASE)
+    png = tmp_path / "fig7.png"
+    r = invoke(table, "--benchmark", "inhand", "--plot", str(png), "--json")
+    assert r.exit_code == 0, r.output
+    assert _json(r)["plot"] == str(png) and png.read_bytes()[:4] == b"\x89PNG"
+    assert invoke(table, "--plot", str(tmp_path / "x.pdf")).exit_code == 2
+    if backends_wanted() is not None and not {"pybullet", "sapien"} <= backends_wanted():
+        return
+    r = invoke(compare, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", *BASE, "--json")
+    assert r.exit_code in (0, 1), r.output
+    data = _json(r)
+    for b in ("pybullet", "sapien"):
+        v = data["summary"][b]["inhand"]
+        assert v["trials"] == 4
+        # the medians are those of the stored trials of that backend (Table II's own computation)
+        ok = [t[b] for t in data["trials"] if t[b]["status"] == "success"]
+        assert v["err_pos_cm"] == pytest.approx(100 * float(np.median([t["score"] for t in ok])))
+    assert "Table II layout" in invoke(compare, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", *BASE).output
+
+
+def test_table_plot_without_inhand_trials_is_a_clear_error(invoke, tmp_path):
+    r = invoke(table, "--plot", str(tmp_path / "f.png"))
+    assert r.exit_code == 2 and "no in-hand trials" in r.output

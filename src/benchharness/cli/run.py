@@ -317,8 +317,10 @@ def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physi
 @click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
 @click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
 @click.option("--run-tiers", is_flag=True, help="Rubik's: only tiers with results (default all twelve, as in the paper).")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="In-hand: also write the Figure-7 box plot (per object, one box per method) to this .png/.svg.")
 @json_option
-def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers, as_json) -> None:
+def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers, plot_path, as_json) -> None:
     """Our results in the papers' layouts, with the published figures beside them.
 
     \b
@@ -326,9 +328,18 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
     seconds (sample std; "-" for single-trial tiers) where the tier was
     completed, "—" where not (with successes/M), "… k/M run" while trials
     are missing. In-hand: Table II (per method: drops %, medians of err_pos,
-    err_pos%, err_or%) and Table III (per task).
+    err_pos%, err_or%) and Table III (per task); ``--plot`` draws the
+    paper's Figure 7 (box plots per object and method).
+
+    \b
+    Examples:
+      benchharness table --benchmark rubiks --run-tiers
+      benchharness table --benchmark inhand --plot figure7.png
     """
-    from ..runner.reports import format_cell, inhand_table2, inhand_table3, rubiks_table
+    from ..runner.reports import format_cell, inhand_box_plot, inhand_table2, inhand_table3, rubiks_table
+
+    if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
+        fail(f"--plot: {plot_path} must end in .png or .svg")
 
     with _open_store(store_path) as store:
         filters = dict(strategy=list(strategies) or None, backend=list(backends) or None,
@@ -395,6 +406,15 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
                     t.add_row(label, *cells)
                 t.add_row("drops %", *[_fmt(r["drops_percent"], 1) for r in rows])
                 console.print(t)
+    if plot_path is not None:
+        try:
+            inhand_box_plot(trials, plot_path)
+        except ValueError as e:
+            fail(f"--plot: {e}")
+        if as_json:
+            out["plot"] = str(plot_path)
+        else:
+            console.print(f"Box plot (Figure 7 layout) written to {plot_path}")
     if as_json:
         emit_json(out)
 
@@ -467,6 +487,15 @@ def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, p
         s.add_row(b, str(v["trials"]), str(v["successes"]), "" if v["completed"] is None else str(v["completed"]).lower(),
                   ms, causes, _fmt(v["real_time_factor"], 2))
     console.print(s)
+    if benchmark == "inhand":
+        h = Table(title="in-hand, per backend (Table II layout): medians over scored trials")
+        for c in ("backend", "n", "discarded", "drops %", "err_pos (cm)", "err_pos%", "err_or%"):
+            h.add_column(c, justify="left" if c == "backend" else "right")
+        for b in names:
+            v = data["summary"][b]["inhand"] or {}
+            h.add_row(b, str(v.get("trials", 0)), str(v.get("discarded", 0)), _fmt(v.get("drops_percent"), 1),
+                      _fmt(v.get("err_pos_cm")), _fmt(v.get("err_pos_percent")), _fmt(v.get("err_or_percent")))
+        console.print(h)
 
 
 # -- results -----------------------------------------------------------------------------------

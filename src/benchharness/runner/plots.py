@@ -47,6 +47,7 @@ def plot_pose_error(trials: Sequence[StoredTrial], path: str | Path, title: str 
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True, constrained_layout=True)
     for i, (label, s) in enumerate(series.items()):
@@ -59,6 +60,7 @@ def plot_pose_error(trials: Sequence[StoredTrial], path: str | Path, title: str 
     axes[0].set_ylabel("position error (mm)")
     axes[1].set_ylabel("rotation error (deg)")
     axes[1].set_xlabel("move index")
+    axes[1].xaxis.set_major_locator(MaxNLocator(integer=True))  # moves are whole numbers
     axes[0].legend(fontsize="small")
     axes[0].set_title(title or "cube pose estimate vs true pose (median per move, all logged estimates)")
     path = Path(path)

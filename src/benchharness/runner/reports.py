@@ -7,6 +7,8 @@
   err_pos%, err_or%; the paper's methods beside.
 * :func:`inhand_table3` — Table III: per task, the metrics of one method;
   the paper's DMG figures beside.
+* :func:`inhand_box_plot` — the paper's Figure 7 from stored trials: per
+  object, one box per method.
 * :func:`compare_backends` — one run's trials on several backends, side by side.
 
 Every number comes from :mod:`benchharness.metrics` (``mean_and_std``,
@@ -35,6 +37,7 @@ __all__ = [
     "rubiks_table",
     "inhand_table2",
     "inhand_table3",
+    "inhand_box_plot",
     "compare_backends",
     "format_cell",
 ]
@@ -274,6 +277,44 @@ def inhand_table3(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
 
 
 
+def inhand_box_plot(trials: Sequence[StoredTrial], path, *, title: str | None = None):
+    """Figure 7 from the store: one panel per pose metric, per object one box per method.
+
+    Method labels are the table's column labels (strategy, robot, backend), so
+    the same method on two simulators gets two boxes side by side. The boxes
+    are :func:`benchharness.metrics.stats.box_stats` numbers, as in the tables.
+    """
+    from ..metrics.inhand import METRICS
+    from ..metrics.plots import box_plot
+
+    scored, _ = _scorable(trials)
+    if not scored:
+        raise ValueError("no in-hand trials with a reached pose in the selection (benchharness run --task inhand-...)")
+    _, col_of = _columns(scored)
+    a = _inhand_arrays(scored)
+    s = score_trials(a["initial"], a["desired"], a["reached"], setup=a["setup"], dropped=a["dropped"],
+                     plan_time_s=a["plan_time_s"], exec_time_s=a["exec_time_s"])
+    cols = {
+        "object": np.array([t.outcome.get("object", "") or "?" for t in scored], dtype=object),
+        "method": np.array([col_of[t.run_key].label for t in scored], dtype=object),
+    }
+    groups = summarize_scores(s, cols, ("object", "method"), a["dropped"])
+    metrics = ["err_pos", "err_pos_percent", "err_or_percent"]
+    return box_plot(groups, metrics, path,
+                    labels={m: f"{METRICS[m].label} ({METRICS[m].unit})" for m in metrics},
+                    scales={m: METRICS[m].scale for m in metrics},
+                    title=title or "In-hand results per object (Figure 7 layout)")
+
+
+def _inhand_summary(rows: Sequence[StoredTrial]) -> dict[str, Any] | None:
+    """Table II figures (drops %, medians) of one backend's in-hand trials, or None."""
+    ours = [r for r in inhand_table2(rows) if r["source"] == "ours"]
+    if not ours:
+        return None
+    r = ours[0]
+    return {k: r[k] for k in ("trials", "discarded", "drops_percent", "err_pos_cm", "err_pos_percent", "err_or_percent")}
+
+
 # -- backend comparison ------------------------------------------------------------------------
 
 
@@ -305,5 +346,6 @@ def compare_backends(runs: Sequence[tuple[str, Sequence[StoredTrial]]], required
             "std_s": None if cell is None else cell.std_s,
             "causes": dict(Counter(t.failure_cause.value for t in rows if t.failure_cause)),
             "real_time_factor": (sum(sims) / sum(walls)) if sims and walls and sum(walls) > 0 else None,
+            "inhand": _inhand_summary(rows) if rows and rows[0].benchmark == "inhand" else None,
         }
     return {"trials": per_trial, "summary": summary}
