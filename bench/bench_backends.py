@@ -17,6 +17,7 @@ and prints steps/s and the real-time factor (simulated s / wall s).
 from __future__ import annotations
 
 import argparse
+import os
 import platform
 import sys
 import time
@@ -39,14 +40,14 @@ def bench(name: str, iterations: int, seconds: float) -> dict:
         s = gripper_scene(b)
         grasp_lift_hold(s, hold_s=0.2)  # holding the cube in the air
         n = int(seconds / b.config.timestep)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         b.step(n)
-        raw = time.perf_counter() - t0
-        t0 = time.perf_counter()
+        raw, raw_cpu = time.perf_counter() - t0, time.process_time() - c0
+        t0, c0 = time.perf_counter(), time.process_time()
         for _ in range(n):
             s.command()
             b.step()
-        ctl = time.perf_counter() - t0
+        ctl, ctl_cpu = time.perf_counter() - t0, time.process_time() - c0
         held = abs(b.get_pose(s.cube).p[2] - (GRASP_Z - 0.065 + 0.10)) < 0.01
         return {
             "backend": name,
@@ -56,6 +57,8 @@ def bench(name: str, iterations: int, seconds: float) -> dict:
             "raw_rtf": n * b.config.timestep / raw,
             "ctl_steps_s": n / ctl,
             "ctl_rtf": n * b.config.timestep / ctl,
+            "raw_cpu_steps_s": n / raw_cpu,
+            "ctl_cpu_steps_s": n / ctl_cpu,
             "held": held,
         }
     finally:
@@ -71,14 +74,16 @@ def main() -> None:
     names = args.backends or get_manager().names("backend")
     print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
           f"timestep 1/240 s, {args.seconds} s simulated per figure")
-    print("| backend | solver iterations | step(n) steps/s | step(n) real-time factor | "
-          "control loop steps/s | control loop real-time factor | cube still held |")
-    print("|---|---|---|---|---|---|---|")
+    print(f"# load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; CPU = steps per CPU second (process_time)")
+    print("| backend | solver iterations | step(n) steps/s | step(n) CPU steps/s | step(n) real-time factor | "
+          "control loop steps/s | control loop CPU steps/s | control loop real-time factor | cube still held |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for name in names:
         for it in args.iterations:
             r = bench(name, it, args.seconds)
-            print(f"| {r['backend']} | {r['iterations']} | {r['raw_steps_s']:,.0f} | {r['raw_rtf']:.1f} | "
-                  f"{r['ctl_steps_s']:,.0f} | {r['ctl_rtf']:.1f} | {'yes' if r['held'] else 'NO'} |", flush=True)
+            print(f"| {r['backend']} | {r['iterations']} | {r['raw_steps_s']:,.0f} | {r['raw_cpu_steps_s']:,.0f} | "
+                  f"{r['raw_rtf']:.1f} | {r['ctl_steps_s']:,.0f} | {r['ctl_cpu_steps_s']:,.0f} | {r['ctl_rtf']:.1f} | "
+                  f"{'yes' if r['held'] else 'NO'} |", flush=True)
 
 
 if __name__ == "__main__":

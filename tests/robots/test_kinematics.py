@@ -3,7 +3,12 @@
 * pytorch-kinematics FK vs yourdfpy FK (a different URDF parser and FK code);
 * Jacobians vs finite differences of FK;
 * IK: random joint configurations within limits -> FK -> IK from other
-  random seeds must reach >= 95 % of the poses within 1 mm / 1 degree.
+  random seeds must reach >= 95 % of the poses within 1 mm / 1 degree;
+* the NumPy FK/Jacobian/DLS twins vs pytorch-kinematics' own, the rotation
+  error vs scipy, seed-first IK vs the restart solver;
+* gravity feed-forward of a spawned robot (the engines' inverse dynamics)
+  vs ``GravityModel``, itself checked against finite differences of the
+  potential energy.
 """
 
 from __future__ import annotations
@@ -126,3 +131,156 @@ def test_ik_reaches_1000_sampled_poses(robots, robot, chain):
     dp, dr = pose_error(arm.fk(res.q), targets)
     ok = (dp <= 1e-3) & ((dr <= np.radians(1.0)) | arm.config.position_only)
     assert ok.mean() >= 0.95
+
+
+@pytest.mark.parametrize("robot,chain", CHAINS)
+def test_numpy_model_matches_pytorch_kinematics(robots, robot, chain):
+    """The NumPy FK/Jacobian used for small batches and the seeded IK equals pytorch-kinematics'."""
+    ch = robots[robot].arm(chain).chain
+    assert ch._np is not None, "the NumPy model failed its construction-time check"
+    q = ch.sample(64, torch.Generator().manual_seed(5))
+    tip, jac = ch._np.fk_jacobian(q)
+    np.testing.assert_allclose(tip, ch._fk_pk(q), atol=1e-12)
+    np.testing.assert_allclose(jac, ch.chain.jacobian(torch.as_tensor(q)).numpy(), atol=1e-12)
+    np.testing.assert_allclose(ch.fk(q[:3]), ch._fk_pk(q[:3]), atol=1e-12)  # small batch: NumPy path
+
+
+@pytest.mark.parametrize("robot,chain", [("pr2", "left_arm"), ("herb", "right_arm")])
+def test_seeded_ik_matches_the_restart_solver(robots, robot, chain):
+    """Seed-first (NumPy descent) vs the pytorch-kinematics restart solver on motion-sized targets.
+
+    Targets are 0.15 rad (std) away from the seed, as in a motion. Both must
+    reach 1e-4 m / 1e-3 rad, and the seed-first answer must be the one
+    continuous with the seed: no farther from it than the restart solver's.
+    """
+    from dataclasses import replace
+
+    arm = robots[robot].arm(chain)
+    ch = arm.chain
+    rng = np.random.default_rng(4)
+    seeds = ch.sample(30, torch.Generator().manual_seed(4), margin=0.3)
+    goals = np.clip(seeds + rng.normal(0.0, 0.15, seeds.shape), ch.lower, ch.upper)
+    targets = ch.fk(goals)
+    fast = ch.ik(targets, seed_q=seeds, seed=0)
+    slow = ch.ik(targets, seed_q=seeds, seed=0, config=replace(arm.robot.ik_config, seed_first=False))
+    assert fast.success.all() and slow.success.all()
+    dp, dr = pose_error(ch.fk(fast.q), targets)
+    assert dp.max() < 1e-4 and dr.max() < 1e-3
+    d_fast = np.abs(fast.q - seeds).max(axis=1)
+    d_slow = np.abs(slow.q - seeds).max(axis=1)
+    assert np.all(d_fast <= d_slow + 1e-3)
+    again = ch.ik(targets, seed_q=seeds, seed=0)
+    np.testing.assert_array_equal(fast.q, again.q)  # deterministic
+
+
+def test_seeded_ik_falls_back_to_restarts(robots):
+    """A seed whose descent cannot converge (2 iterations) still gets a solution from the restarts."""
+    from dataclasses import replace
+
+    arm = robots["pr2"].arm("left_arm")
+    ch = arm.chain
+    q_true = ch.sample(5, torch.Generator().manual_seed(8), margin=0.2)
+    seeds = ch.sample(5, torch.Generator().manual_seed(9), margin=0.2)
+    cfg = replace(arm.robot.ik_config, max_iterations=2, refine_iterations=0, retry_num_retries=32)
+    first = ch._ik_seeded(ch.fk(q_true), seeds, cfg)
+    assert not first.success.any()
+    res = ch.ik(ch.fk(q_true), seed_q=seeds, seed=1, config=cfg)
+    assert res.success.mean() >= 0.8
+    dp, _ = pose_error(ch.fk(res.q), ch.fk(q_true))
+    assert np.all(dp[res.success] < 1e-4)
+
+
+def test_rotation_error_matches_scipy():
+    """The seeded IK's rotation error (shortest rotation vector) vs scipy, incl. angles near 0 and pi."""
+    from scipy.spatial.transform import Rotation
+
+    from benchharness.kinematics import _rotvec_between
+
+    cur = Rotation.random(300, random_state=2)
+    rng = np.random.default_rng(0)
+    cases = [Rotation.random(300, random_state=1),
+             Rotation.from_rotvec(rng.normal(0.0, 1e-9, (300, 3))) * cur,
+             Rotation.from_rotvec(np.outer(np.linspace(np.pi - 2e-3, np.pi, 300), [0.6, 0.0, 0.8])) * cur]
+    for tgt in cases:
+        got = _rotvec_between(tgt.as_matrix(), cur.as_matrix())
+        want = (tgt * cur.inv()).as_rotvec()
+        assert (Rotation.from_rotvec(got) * Rotation.from_rotvec(want).inv()).magnitude().max() < 1e-9
+        np.testing.assert_allclose(np.linalg.norm(got, axis=1), np.linalg.norm(want, axis=1), atol=1e-9)
+
+
+@pytest.mark.parametrize("robot,chain", [("pr2", "left_arm"), ("herb", "left_arm"), ("allegro", "index")])
+def test_numpy_dls_matches_pytorch_kinematics_solver(robots, robot, chain):
+    """The NumPy solver (small IK passes) vs pytorch-kinematics' PseudoInverseIK from the same restarts.
+
+    Same iteration, same sticky convergence and limit refinement: they must
+    converge on the same restarts (but for a rare borderline one) and, where
+    both converge, land on the same joint vector (to 1e-6 rad) for >= 90 %.
+    """
+    import torch as _t
+
+    from benchharness.kinematics import DTYPE
+
+    arm = robots[robot].arm(chain)
+    ch = arm.chain
+    cfg = arm.robot.ik_config
+    targets = ch.fk(ch.sample(20, _t.Generator().manual_seed(31)))
+    init = ch.sample(20 * 3, _t.Generator().manual_seed(32)).reshape(20, 3, ch.dof)
+    q_np, _, _, c_np = ch._dls(targets, init, cfg, cfg.max_iterations, stop_when_any=False)
+    q_pk, _, c_pk = ch._pk_solve(_t.as_tensor(targets, dtype=DTYPE), _t.as_tensor(init, dtype=DTYPE), cfg,
+                                 cfg.max_iterations, False)
+    c_pk = c_pk.numpy()
+    both = c_np & c_pk
+    assert (c_np == c_pk).mean() >= 0.95 and both.sum() >= 10  # random restarts: ~40 % converge
+    diff = np.abs(q_np[both] - q_pk.numpy()[both]).max(axis=1)
+    # a redundant arm's solutions form a continuum: a restart that crosses the tolerance one iteration
+    # apart (rounding) ends on a nearby point of it, so a few may differ by mrad
+    assert (diff < 1e-6).mean() >= 0.9 and diff.max() < 2e-2
+
+
+def test_small_unseeded_batches_use_numpy_and_reach_targets(robots):
+    """40 targets x 4 restarts run in NumPy: >= 95 % within 1 mm / 1 deg, deterministic."""
+    arm = robots["pr2"].arm("right_arm")
+    ch = arm.chain
+    targets = ch.fk(ch.sample(40, torch.Generator().manual_seed(41)))
+    a = ch.ik(targets, seed=2)
+    dp, dr = pose_error(ch.fk(a.q), targets)
+    assert ((dp <= 1e-3) & (dr <= np.radians(1.0))).mean() >= 0.95
+    np.testing.assert_array_equal(a.q, ch.ik(targets, seed=2).q)
+
+
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+@pytest.mark.parametrize("robot", ["pr2", "herb"])
+def test_robot_gravity_feed_forward_matches_urdf_model(make_backend, make_robot, backend, robot):
+    """Robot's feed-forward (the engine's gravity_torques) vs GravityModel, and the fallback path.
+
+    The robot is spawned on a yawed base at a random configuration; hand
+    joints get 0 (the hands hold by their own drives). A backend without
+    the capability makes the robot use GravityModel itself: same torques.
+    """
+    from dataclasses import replace
+
+    from benchharness.geometry import Pose
+    from benchharness.robots.gravity import GravityModel
+
+    be = make_backend(backend)
+    r = make_robot(robot)
+    base = Pose([0.2, -0.1, 0.0], [0.0, 0.0, np.sin(0.3), np.cos(0.3)])
+    r.spawn(be, base)
+    lo = np.array([r.urdf_joints[j].lower for j in r.joint_names])
+    hi = np.array([r.urdf_joints[j].upper for j in r.joint_names])
+    lo, hi = np.where(np.isfinite(lo), lo, -np.pi), np.where(np.isfinite(hi), hi, np.pi)
+    q = lo + np.random.default_rng(3).uniform(0.1, 0.9, len(lo)) * (hi - lo)
+    be.set_joint_positions(r.body, q)
+    joints = r._gravity_joints()
+    want = GravityModel(r.urdf_path, be.config.gravity).torques(dict(zip(r.joint_names, q)), joints,
+                                                                base.rotation.as_matrix())
+    assert np.abs(want).max() > 1.0
+    got = r._gravity_torques(joints)
+    np.testing.assert_allclose(got, want, atol=1e-4 * max(1.0, np.abs(want).max()))
+    grip = [j for j in r.joint_names if j not in joints]
+    if grip:
+        assert not np.any(r._gravity_torques(grip))
+    be.capabilities = replace(be.capabilities, gravity_torques=False)  # this instance only
+    r._gcache = None
+    # (SAPIEN reports q in float32: the model sees q to ~1e-7 rad)
+    np.testing.assert_allclose(r._gravity_torques(joints), want, atol=1e-6 * max(1.0, np.abs(want).max()))

@@ -235,11 +235,24 @@ def parse_urdf(path: str | Path) -> UrdfModel:
 def collision_only_copy(path: str | Path) -> str:
     """Write a copy of the URDF without ``<visual>`` elements; mesh paths made absolute.
 
-    Returns the path of the temporary file (the caller deletes it).
+    ``continuous`` joints become ``revolute`` with limits -inf..inf: SAPIEN's
+    loader makes a continuous joint a *wrapped* PhysX revolute joint, whose
+    position wraps past 2*pi while a drive target does not (a driven joint
+    sent past 2*pi spins wildly), and a revolute with infinite limits an
+    unwrapped, free one — what a URDF continuous joint means, and what
+    PyBullet does. Returns the path of the temporary file (the caller deletes it).
     """
     path = Path(path).resolve()
     tree = ET.parse(path)
     root = tree.getroot()
+    for joint in root.findall("joint"):
+        if joint.get("type") == "continuous":
+            joint.set("type", "revolute")
+            lim = joint.find("limit")
+            if lim is None:
+                lim = ET.SubElement(joint, "limit")
+            lim.set("lower", "-inf")
+            lim.set("upper", "inf")
     for link in root.findall("link"):
         for vis in link.findall("visual"):
             link.remove(vis)

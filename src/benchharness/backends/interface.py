@@ -70,6 +70,7 @@ class Capabilities:
     mesh_collision: bool = True  #: convex mesh collision shapes
     joint_friction: bool = True  #: :meth:`Backend.set_joint_friction`
     mimic_joints: bool = False  #: URDF ``<mimic>`` enforced by the engine
+    gravity_torques: bool = False  #: :meth:`Backend.gravity_torques` (the engine's own inverse dynamics)
 
 
 @dataclass(frozen=True)
@@ -322,6 +323,25 @@ class Backend(abc.ABC):
         URDF effort limit. Targets persist until changed.
         """
 
+    def gravity_torques(self, body: BodyId) -> np.ndarray:
+        """Joint torques/forces (:meth:`joint_names` order) that hold the body still against gravity.
+
+        The inverse dynamics of the current configuration with zero joint
+        velocities and accelerations and the base held where it is (for a
+        free base: zero base acceleration), from the engine's own masses and
+        inertial frames, with gravity in the world frame whatever the base's
+        orientation: ``tau = G(q)``, positive in each joint's positive
+        direction, i.e. the torque a drive must add to hold the pose. Only
+        the body's own links count (not attached or touching bodies).
+
+        Why in the interface: a robot feeds ``G(q)`` forward every control
+        tick; the engines compute it in microseconds, a Python model of the
+        URDF takes milliseconds. Backends without it raise
+        :class:`CapabilityError` (``capabilities.gravity_torques`` is False)
+        and callers use :class:`benchharness.robots.gravity.GravityModel`.
+        """
+        raise CapabilityError(f"backend {self.name!r} cannot compute gravity torques")
+
     @abc.abstractmethod
     def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
         """A constant Coulomb friction torque (N·m) at passive joints.
@@ -347,8 +367,16 @@ class Backend(abc.ABC):
         max_distance: float | np.ndarray,
         *,
         ignore_bodies: Sequence[BodyId] = (),
+        ignore_links: Sequence[tuple[BodyId, str | None]] = (),
     ) -> RayHits:
-        """Batched ray casts (origins, unit directions: (n, 3)) against all bodies."""
+        """Batched ray casts (origins, unit directions: (n, 3)) against all bodies.
+
+        Rays pass through every body in ``ignore_bodies`` and through the
+        links named in ``ignore_links`` as ``(body, link)`` pairs (``None`` or
+        the root link's name for the base), e.g. a robot's own fingertip
+        carrying a time-of-flight sensor, while the rest of the robot still
+        blocks the ray.
+        """
 
     @abc.abstractmethod
     def attach(

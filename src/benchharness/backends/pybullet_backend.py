@@ -27,6 +27,7 @@ from typing import Sequence
 import numpy as np
 
 from ..geometry import Pose
+from . import PYBULLET_CAPABILITIES
 from ._drives import as_array, drive_command
 from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, mass_properties, parse_urdf
 from .interface import (
@@ -54,6 +55,8 @@ import pybullet as pb
 MAX_SPEED = 1.0e4
 _RAY_BATCH = 16000
 _ATTACH_MAX_FORCE = 1.0e5
+#: rad or m: the drive law's cached inverse mass matrix is recomputed once a joint moved this far
+MASS_MATRIX_REFRESH = 1.0e-3
 
 
 @dataclass
@@ -77,8 +80,15 @@ class _Body:
     q_prev: np.ndarray | None = None  #: joint positions at the start of the last driven step
     q_prev_step: int = -10
     driven_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    minv: np.ndarray | None = None  #: cached inverse mass matrix (see PyBulletBackend._mass_inverse)
+    minv_q: np.ndarray | None = None  #: joint positions it was computed at
+    meff: np.ndarray | None = None  #: 1 / diag(minv) of the movable joints
+    gravity_base: np.ndarray | None = None  #: world gravity in a fixed base's inertial frame (cached)
     driven_pb: list[int] = field(default_factory=list)
+    ones: list[float] = field(default_factory=list)  #: velocity gains (1.0) for driven_pb
+    drive_cache: tuple | None = None  #: per-step constants of the drive law (cleared by set_joint_targets)
     temp_files: list[str] = field(default_factory=list)
+    jmap: dict[str, int] = field(default_factory=dict)  #: joint name -> index (see _joint_sel)
 
     @property
     def index_link(self) -> dict[int, str | None]:
@@ -91,7 +101,7 @@ class _Body:
 
 class PyBulletBackend(Backend):
     name = "pybullet"
-    capabilities = Capabilities(camera=True, mesh_collision=True, joint_friction=True, mimic_joints=False)
+    capabilities = PYBULLET_CAPABILITIES
     default_solver_iterations = 50  # DESIGN.md: >= 50 at 1/240 s, else a 90 deg twist ends at ~102 deg
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
@@ -116,6 +126,7 @@ class PyBulletBackend(Backend):
         self._steps = 0
         self._closed = False
         self._grounds: dict[int, float] = {}
+        self._gravity = np.asarray(c.gravity, dtype=float)
 
     # -- lifetime --------------------------------------------------------------
     def close(self) -> None:
@@ -168,14 +179,13 @@ class PyBulletBackend(Backend):
     def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
         if joints is None:
             return list(range(len(b.joints)))
-        names = [j.name for j in b.joints]
-        out = []
-        for n in joints:
-            try:
-                out.append(names.index(n))
-            except ValueError:
-                raise BackendError(f"body {b.name!r} has no movable joint {n!r}; joints: {names}") from None
-        return out
+        if len(b.jmap) != len(b.joints):  # name -> index, built once per body
+            b.jmap = {j.name: i for i, j in enumerate(b.joints)}
+        try:
+            return [b.jmap[n] for n in joints]
+        except KeyError as exc:
+            names = [j.name for j in b.joints]
+            raise BackendError(f"body {b.name!r} has no movable joint {exc.args[0]!r}; joints: {names}") from None
 
     # -- time ------------------------------------------------------------------
     @property
@@ -185,7 +195,8 @@ class PyBulletBackend(Backend):
     def step(self, n: int = 1) -> None:
         cid = self._cid
         driven = [b for b in self._bodies.values() if b.driven.any()]
-        dynamic = [(b.uid, h) for h, b in self._bodies.items() if not (b.fixed and not b.joints)]
+        # bases that can move (a fixed base cannot; its joints are checked after the loop)
+        dynamic = [(b.uid, h) for h, b in self._bodies.items() if not b.fixed]
         for _ in range(int(n)):
             for b in driven:
                 self._apply_drives(b)
@@ -209,27 +220,68 @@ class PyBulletBackend(Backend):
             f"(t = {self.time:.4f} s): the simulation blew up"
         )
 
-    def _joint_dynamics(self, b: _Body, q: list[float], v: list[float]) -> tuple[np.ndarray, np.ndarray]:
-        """Effective inertia ``1/(M^-1)_ii`` and free acceleration ``M^-1 (-bias)`` of each joint."""
+    def _inverse_dynamics(self, b: _Body, q: Sequence[float], v: Sequence[float]) -> np.ndarray:
+        """Joint part of ``calculateInverseDynamics(q, v, 0)``: gravity + Coriolis torques, world gravity.
+
+        PyBullet's inverse dynamics expresses the world's gravity vector in
+        the base's inertial frame without rotating it, i.e. it is only right
+        for an upright base. So gravity is set to ``R^T g`` (``R`` = the base
+        inertial frame's world rotation) for the call and restored after;
+        nothing is stepped in between. A free base gets zero base
+        acceleration (its 6 base rows are dropped).
+        """
         cid = self._cid
-        m = np.asarray(pb.calculateMassMatrix(b.uid, q, physicsClientId=cid), dtype=float)
         n = len(q)
-        off = m.shape[0] - n
+        g = self._gravity
+        gb = b.gravity_base
+        if gb is None:
+            _, orn = pb.getBasePositionAndOrientation(b.uid, physicsClientId=cid)
+            gb = np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3).T @ g
+            if b.fixed:  # a fixed base only turns through set_pose, which clears this
+                b.gravity_base = gb
+        tilted = bool(np.max(np.abs(gb - g)) > 1e-12)
+        if tilted:
+            pb.setGravity(*gb.tolist(), physicsClientId=cid)
         try:
-            minv = np.linalg.inv(m)
-        except np.linalg.LinAlgError:
-            minv = np.diag(1.0 / np.maximum(np.diag(m), 1e-12))
-        meff = 1.0 / np.diag(minv)[off:]
-        if b.fixed:
-            bias = np.asarray(
-                pb.calculateInverseDynamics(b.uid, q, v, [0.0] * n, physicsClientId=cid), dtype=float
-            )
-            acc = minv @ -bias[-n:]
-        else:
-            # PyBullet has no inverse dynamics for a floating base; gravity alone gives a free
-            # floating articulation no relative joint acceleration, and Coriolis terms are neglected
-            acc = np.zeros(n)
-        return meff, acc
+            if b.fixed:
+                tau = pb.calculateInverseDynamics(b.uid, list(q), list(v), [0.0] * n, physicsClientId=cid)
+            else:
+                tau = pb.calculateInverseDynamics(
+                    b.uid, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0] + list(q), [0.0] * 6 + list(v), [0.0] * (6 + n),
+                    physicsClientId=cid,
+                )
+        finally:
+            if tilted:
+                pb.setGravity(*self.config.gravity, physicsClientId=cid)
+        return np.asarray(tau, dtype=float)[-n:]
+
+    def gravity_torques(self, body: BodyId) -> np.ndarray:
+        b = self._b(body)
+        if not b.joints:
+            return np.zeros(0)
+        q = [s[0] for s in pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)]
+        return self._inverse_dynamics(b, q, [0.0] * len(q))
+
+    def _mass_inverse(self, b: _Body, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Inverse mass matrix and each joint's effective inertia ``1/(M^-1)_ii``, cached.
+
+        Why cached: ``calculateMassMatrix`` plus the inverse of the PR2's
+        19x19 matrix cost ~75 us, a quarter of a physics step, and a held
+        robot's ``M(q)`` does not change. It is recomputed whenever any joint
+        has moved more than :data:`MASS_MATRIX_REFRESH` (rad or m) since, so
+        the effective inertia and free acceleration used by the drive law are
+        those of the current configuration to ~0.1 %.
+        """
+        if b.minv is None or b.minv_q is None or float(np.max(np.abs(q - b.minv_q))) > MASS_MATRIX_REFRESH:
+            m = np.array(pb.calculateMassMatrix(b.uid, q.tolist(), physicsClientId=self._cid), dtype=float)
+            try:
+                minv = np.linalg.inv(m)
+            except np.linalg.LinAlgError:
+                minv = np.diag(1.0 / np.maximum(np.diag(m), 1e-12))
+            n = len(q)
+            b.minv, b.minv_q = minv, q.copy()
+            b.meff = 1.0 / np.diag(minv)[m.shape[0] - n:]
+        return b.minv, b.meff
 
     def _apply_drives(self, b: _Body) -> None:
         """PhysX's implicit drive law, realised by Bullet's velocity motor inside its solver.
@@ -248,35 +300,49 @@ class PyBulletBackend(Backend):
         * a blocked joint (a finger on a cube) cannot move, so the motor pushes
           with ``k (q* - q) + d v*``, as a PhysX drive does;
         * everything is solved together with the contacts.
+
+        ``a = M^-1 (-bias)`` with the bias (gravity + Coriolis) from inverse
+        dynamics every step and ``M^-1`` from :meth:`_mass_inverse`.
         """
         dt = self.config.timestep
         sel = b.driven_idx
         states = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
-        q = [s[0] for s in states]
-        v = [s[1] for s in states]
+        q = np.array([s[0] for s in states])
         # The joint's actual motion over the last step. Bullet's reported velocity can carry
         # motion that contacts undo at the position level (split impulse); feeding that back
         # into the drive makes a blocked finger push harder and harder.
         if b.q_prev is not None and b.q_prev_step == self._steps - 1:
-            v = ((np.asarray(q) - b.q_prev) / dt).tolist()
-        b.q_prev = np.asarray(q)
+            v = (q - b.q_prev) / dt
+        else:
+            v = np.array([s[1] for s in states])
+        b.q_prev = q
         b.q_prev_step = self._steps
-        meff, acc = self._joint_dynamics(b, q, v)
-        qs, vs = np.asarray(q)[sel], np.asarray(v)[sel]
-        m, a = meff[sel], acc[sel]
-        k, d = b.kp[sel], b.kd[sel]
-        c = k * dt + d
-        with np.errstate(divide="ignore", invalid="ignore"):
-            vt = np.where(c > 0, (k * (b.target_q[sel] - qs) + d * b.target_v[sel]) / c, 0.0)
-        vref = vs + dt * a
-        vnext = (m * vref + dt * c * vt) / (m + dt * c)
+        minv, meff = self._mass_inverse(b, q)
+        if b.drive_cache is None:  # the drive settings' per-step constants, until set_joint_targets
+            k, d = b.kp[sel], b.kd[sel]
+            c = k * dt + d
+            with np.errstate(divide="ignore"):
+                inv_c = np.where(c > 0, 1.0 / c, 0.0)
+            b.drive_cache = (k, d * b.target_v[sel], b.target_q[sel], c, dt * c, inv_c, b.fmax[sel])
+        k, dv, tq, c, dtc, inv_c, fmax = b.drive_cache
+        m = meff[sel]
+        if b.fixed:
+            a = (minv @ -self._inverse_dynamics(b, q.tolist(), v.tolist()))[sel]
+        else:
+            # the joints of a free-floating body: gravity alone gives no relative joint
+            # acceleration; Coriolis terms are neglected
+            a = 0.0
+        vt = (k * (tq - q[sel]) + dv) * inv_c
+        vref = v[sel] + dt * a
+        mdc = m + dtc
+        vnext = (m * vref + dtc * vt) / mdc
         # cap: the law's force at rest (what a blocked joint pushes with), or the force that
         # free motion needs to reach v' if larger; never an explicit c |v| term, which would be
         # unstable (period-2 chatter) on light links in contact
-        f = np.minimum(np.maximum(c * np.abs(vt), m * c * np.abs(vt - vref) / (m + dt * c)), b.fmax[sel])
+        f = np.minimum(np.maximum(c * np.abs(vt), m * c * np.abs(vt - vref) / mdc), fmax)
         pb.setJointMotorControlArray(
             b.uid, b.driven_pb, pb.VELOCITY_CONTROL, targetVelocities=vnext.tolist(), forces=f.tolist(),
-            velocityGains=[1.0] * len(f), physicsClientId=self._cid,
+            velocityGains=b.ones, physicsClientId=self._cid,
         )
 
     # -- bodies ----------------------------------------------------------------
@@ -494,6 +560,7 @@ class PyBulletBackend(Backend):
 
     def set_pose(self, body: BodyId, pose: Pose) -> None:
         b = self._b(body)
+        b.gravity_base = None
         lin, ang = pb.getBaseVelocity(b.uid, physicsClientId=self._cid)
         pb.resetBasePositionAndOrientation(b.uid, *self._com_pose_of(pose, b.base_inertial), physicsClientId=self._cid)
         pb.resetBaseVelocity(b.uid, lin, ang, physicsClientId=self._cid)
@@ -546,6 +613,7 @@ class PyBulletBackend(Backend):
         sel = self._joint_sel(b, joints)
         pos = as_array(positions, len(sel), "positions")
         b.q_prev = None  # a teleport is not motion
+        b.minv = None
         for i, q in zip(sel, pos):
             pb.resetJointState(b.uid, b.joint_index[i], float(q), 0.0, physicsClientId=self._cid)
 
@@ -574,6 +642,8 @@ class PyBulletBackend(Backend):
         b.driven[sel] = True
         b.driven_idx = np.nonzero(b.driven)[0]
         b.driven_pb = [b.joint_index[i] for i in b.driven_idx]
+        b.ones = [1.0] * len(b.driven_pb)
+        b.drive_cache = None
 
     def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
         b = self._b(body)
@@ -617,6 +687,7 @@ class PyBulletBackend(Backend):
         max_distance: float | np.ndarray,
         *,
         ignore_bodies: Sequence[BodyId] = (),
+        ignore_links: Sequence[tuple[BodyId, str | None]] = (),
     ) -> RayHits:
         o = np.atleast_2d(np.asarray(origins, dtype=float))
         dvec = np.atleast_2d(np.asarray(directions, dtype=float))
@@ -625,6 +696,10 @@ class PyBulletBackend(Backend):
         maxd = np.broadcast_to(np.asarray(max_distance, dtype=float), (n,)).copy()
         ignore = set(int(x) for x in ignore_bodies)
         ignore_uid = {self._bodies[h].uid for h in ignore if h in self._bodies}
+        ignore_link = set()  # (uid, pybullet link index)
+        for h, link in ignore_links:
+            lb = self._b(int(h))
+            ignore_link.add((lb.uid, self._link(lb, link)))
         hit = np.zeros(n, dtype=bool)
         dist = np.full(n, np.inf)
         point = np.full((n, 3), np.nan)
@@ -646,7 +721,7 @@ class PyBulletBackend(Backend):
                     if uid < 0 or uid not in self._uid2h:
                         continue
                     d_hit = start[i] + r[2] * (maxd[i] - start[i])
-                    if uid in ignore_uid:
+                    if uid in ignore_uid or (uid, r[1]) in ignore_link:
                         start[i] = d_hit + 1e-4  # rays starting inside a convex shape do not hit it
                         if start[i] < maxd[i]:
                             nxt.append(i)

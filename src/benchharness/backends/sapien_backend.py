@@ -29,6 +29,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..geometry import Pose
+from . import SAPIEN_CAPABILITIES
 from ._drives import as_array, drive_command
 from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, collision_only_copy, mass_properties, parse_urdf
 from .interface import (
@@ -95,7 +96,10 @@ class _Body:
     fmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
     friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
     drive_props: dict[int, tuple[float, float, float]] = field(default_factory=dict)
+    drive_targets: dict[int, tuple[float, float]] = field(default_factory=dict)  #: last (q*, v*) sent
+    gravity_tree: Any = None  #: cached (links, downstream mask, prismatic, masses) for a free base
     temp_files: list[str] = field(default_factory=list)
+    jmap: dict[str, int] = field(default_factory=dict)  #: joint name -> index (see _joint_sel)
 
     @property
     def root(self) -> Any:
@@ -111,7 +115,7 @@ class _Body:
 
 class SapienBackend(Backend):
     name = "sapien"
-    capabilities = Capabilities(camera=False, mesh_collision=True, joint_friction=True, mimic_joints=False)
+    capabilities = SAPIEN_CAPABILITIES
     default_solver_iterations = 20  # DESIGN.md spike: TGS with 20 position iterations twists the cube correctly
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
@@ -191,14 +195,13 @@ class SapienBackend(Backend):
     def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
         if joints is None:
             return list(range(len(b.joints)))
-        names = [j.name for j in b.joints]
-        out = []
-        for n in joints:
-            try:
-                out.append(names.index(n))
-            except ValueError:
-                raise BackendError(f"body {b.name!r} has no movable joint {n!r}; joints: {names}") from None
-        return out
+        if len(b.jmap) != len(b.joints):  # name -> index, built once per body
+            b.jmap = {j.name: i for i, j in enumerate(b.joints)}
+        try:
+            return [b.jmap[n] for n in joints]
+        except KeyError as exc:
+            names = [j.name for j in b.joints]
+            raise BackendError(f"body {b.name!r} has no movable joint {exc.args[0]!r}; joints: {names}") from None
 
     def _register(self, b: _Body) -> int:
         self._bodies[b.handle] = b
@@ -223,7 +226,8 @@ class SapienBackend(Backend):
     def step(self, n: int = 1) -> None:
         if self._closed:
             raise BackendError("backend is closed")
-        roots = [(h, b.root) for h, b in self._bodies.items() if not (b.fixed and b.articulation is None)]
+        # bases that can move (a fixed base cannot; articulation joints are checked after the loop)
+        roots = [(h, b.root) for h, b in self._bodies.items() if not b.fixed]
         arts = [(h, b.articulation) for h, b in self._bodies.items() if b.articulation is not None]
         for _ in range(int(n)):
             self._scene.step()
@@ -494,14 +498,69 @@ class SapienBackend(Backend):
         q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
         b.target_q[sel], b.target_v[sel], b.kp[sel], b.kd[sel], b.fmax[sel] = q, v, k, d, f
         b.driven[sel] = True
-        for i, qi, vi, ki, di, fi in zip(sel, q, v, k, d, f):
+        # PhysX keeps drive settings until changed: only changed values are sent (a held robot
+        # re-sends the same targets every control tick, and each setter is a C++ call)
+        props, targets = b.drive_props, b.drive_targets
+        for i, qi, vi, ki, di, fi in zip(sel.tolist(), q.tolist(), v.tolist(), k.tolist(), d.tolist(), f.tolist()):
             j = b.sjoints[i]
-            prop = (float(ki), float(di), float(fi))
-            if b.drive_props.get(int(i)) != prop:  # the setter is slow; targets change every step
+            prop = (ki, di, fi)
+            if props.get(i) != prop:
                 j.set_drive_property(*prop, "force")
-                b.drive_props[int(i)] = prop
-            j.set_drive_target(float(qi))
-            j.set_drive_velocity_target(float(vi))
+                props[i] = prop
+            last = targets.get(i)
+            if last is None or last[0] != qi:
+                j.set_drive_target(qi)
+            if last is None or last[1] != vi:
+                j.set_drive_velocity_target(vi)
+            targets[i] = (qi, vi)
+
+    def gravity_torques(self, body: BodyId) -> np.ndarray:
+        """Gravity holding torques in our joint order.
+
+        Fixed base: PhysX's generalized gravity force
+        (``compute_passive_force(gravity=True)``). A free-floating
+        articulation gets zeros from PhysX (gravity alone accelerates no
+        joint of a falling body), so there the holding torques for a base
+        held in place are summed from PhysX's own link masses, mass centres
+        and joint frames: ``tau_j = -a_j . sum_i (c_i - o_j) x m_i g`` over the
+        links ``i`` downstream of revolute joint ``j`` (prismatic:
+        ``-a_j . sum_i m_i g``).
+        """
+        b = self._b(body)
+        if b.articulation is None or not b.joints:
+            return np.zeros(0)
+        art = b.articulation
+        if b.fixed:
+            qf = art.compute_passive_force(gravity=True, coriolis_and_centrifugal=False)
+            return np.asarray(qf, dtype=float)[b.perm]
+        if b.gravity_tree is None:
+            links = list(art.links)
+            index = {id(l): k for k, l in enumerate(links)}
+            parent = [-1] * len(links)
+            for j in art.joints:
+                if j.parent_link is not None:
+                    parent[index[id(j.child_link)]] = index[id(j.parent_link)]
+            down = np.zeros((len(b.sjoints), len(links)))
+            for r, j in enumerate(b.sjoints):
+                top = index[id(j.child_link)]
+                for k in range(len(links)):
+                    a = k
+                    while a != -1 and a != top:
+                        a = parent[a]
+                    down[r, k] = a == top
+            prism = np.array([j.type == "prismatic" for j in b.sjoints])
+            b.gravity_tree = (links, down, prism, np.array([l.mass for l in links]))
+        links, down, prism, mass = b.gravity_tree
+        g = np.asarray(self.config.gravity, dtype=float)
+        com = np.array([_bp(l.entity_pose * l.cmass_local_pose).p for l in links])
+        frames = [_bp(j.get_global_pose()) for j in b.sjoints]
+        axis = np.array([f.rotation.as_matrix()[:, 0] for f in frames])  # PhysX joints move along/about x
+        origin = np.array([f.p for f in frames])
+        m_down = down @ mass
+        moment = down @ (mass[:, None] * com) - m_down[:, None] * origin
+        tau = -np.einsum("ji,ji->j", axis, np.cross(moment, g))
+        tau[prism] = -m_down[prism] * (axis[prism] @ g)
+        return tau
 
     def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
         b = self._b(body)
@@ -515,6 +574,7 @@ class SapienBackend(Backend):
                 j.set_drive_property(*prop, "force")
                 b.drive_props[int(i)] = prop
                 j.set_drive_velocity_target(0.0)
+                b.drive_targets.pop(int(i), None)
 
     # -- interaction -----------------------------------------------------------
     def contacts(self, body_a: BodyId | None = None, body_b: BodyId | None = None) -> list[Contact]:
@@ -552,6 +612,7 @@ class SapienBackend(Backend):
         max_distance: float | np.ndarray,
         *,
         ignore_bodies: Sequence[BodyId] = (),
+        ignore_links: Sequence[tuple[BodyId, str | None]] = (),
     ) -> RayHits:
         o = np.atleast_2d(np.asarray(origins, dtype=float))
         dvec = np.atleast_2d(np.asarray(directions, dtype=float))
@@ -559,6 +620,12 @@ class SapienBackend(Backend):
         dvec = dvec / np.linalg.norm(dvec, axis=1, keepdims=True)
         maxd = np.broadcast_to(np.asarray(max_distance, dtype=float), (n,))
         ignore = set(int(x) for x in ignore_bodies)
+        ignore_link = set()  # (handle, link name or None), as _entity_map reports them
+        for h, link in ignore_links:
+            lb = self._b(int(h))
+            self._link(lb, link)  # unknown links raise
+            root = lb.urdf.root_link if lb.urdf is not None else None
+            ignore_link.add((int(h), None if link == root else link))
         hit = np.zeros(n, dtype=bool)
         dist = np.full(n, np.inf)
         point = np.full((n, 3), np.nan)
@@ -576,7 +643,7 @@ class SapienBackend(Backend):
                     break
                 ent = emap.get(r.component.entity.per_scene_id)
                 d_hit = start + float(r.distance)
-                if ent is not None and ent[0] in ignore:
+                if ent is not None and (ent[0] in ignore or ent in ignore_link):
                     exit_d = _ray_exit(r.shape, _bp(r.component.entity_pose), org, dvec[i])
                     start = start + max(float(r.distance), exit_d) + 1e-6
                     continue

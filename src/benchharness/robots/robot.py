@@ -53,7 +53,9 @@ class Robot:
         self.backend: Backend | None = None
         self.body: BodyId | None = None
         self._base_rot = np.eye(3)
-        self._gcache: tuple[np.ndarray, dict[str, float]] | None = None
+        self._gcache: tuple[np.ndarray, np.ndarray] | None = None
+        self._gj: tuple[str, ...] | None = None
+        self._plans: dict[tuple[str, ...], tuple] = {}
 
     # -- description -------------------------------------------------------------
     @property
@@ -129,7 +131,7 @@ class Robot:
         if names != self.joint_names:
             raise RuntimeError(f"backend joint order {names} differs from the URDF's {self.joint_names}")
         self._base_rot = pose.rotation.as_matrix()
-        self._gravity = GravityModel(self.urdf_path, backend.config.gravity)
+        self._gravity = None  # built on first use, only for backends without gravity_torques
         self._gcache = None
         q0 = self.home() if q is None else np.asarray(q, dtype=float)
         backend.set_joint_positions(self.body, q0)
@@ -158,51 +160,89 @@ class Robot:
         return st.velocities[[self.joint_names.index(j) for j in joints]]
 
     def _gravity_joints(self) -> list[str]:
-        grip = {j for g in self.config.grippers for j in g.joints}
-        return [j for j in self.joint_names if j not in grip]
+        """Every joint but the grippers' (a new list each call; the names are computed once)."""
+        if self._gj is None:
+            grip = {j for g in self.config.grippers for j in g.joints}
+            self._gj = tuple(j for j in self.joint_names if j not in grip)
+        return list(self._gj)
+
+    def _drive_plan(self, joints: tuple[str, ...]) -> tuple:
+        """Per joint group, everything :meth:`drive` needs that does not change: cached.
+
+        Why: strategies drive the same few groups every control tick; looking
+        names up in lists each time cost more than the physics step.
+        """
+        plan = self._plans.get(joints)
+        if plan is None:
+            idx = np.array([self.joint_names.index(j) for j in joints], dtype=int)
+            k = np.array([self._gains[j][0] for j in joints])
+            d = np.array([self._gains[j][1] for j in joints])
+            eff = np.array([self.urdf_joints[j].effort for j in joints])
+            gj = set(self._gravity_joints())
+            sel = np.array([i for i, j in enumerate(joints) if j in gj], dtype=int)
+            carried = {j for a in self.config.arms if a.gravity_carried for j in a.joints}
+            carried_mask = np.array([j in carried for j in joints], dtype=bool)
+            plan = (list(joints), idx, k, d, k.tolist(), d.tolist(), eff, sel, idx[sel], carried_mask)
+            self._plans[joints] = plan
+        return plan
 
     def drive(self, joints: Sequence[str], q: np.ndarray, qd: np.ndarray | None = None) -> None:
         """PD targets for ``joints`` with gravity feed-forward folded into the position target."""
         be = self._require()
-        joints = list(joints)
-        if not joints:  # nothing to drive
+        if not len(joints):  # nothing to drive
             return
-        idx = [self.joint_names.index(j) for j in joints]
+        names, idx, k, d, k_list, d_list, eff, sel, gidx, carried = self._drive_plan(tuple(joints))
         self._targets[idx] = q
-        k = np.array([self._gains[j][0] for j in joints])
-        d = np.array([self._gains[j][1] for j in joints])
-        eff = np.array([self.urdf_joints[j].effort for j in joints])
-        tau = self._gravity_torques(joints)
-        carried = {j for a in self.config.arms if a.gravity_carried for j in a.joints}
-        limit = eff + np.array([abs(t) if j in carried else 0.0 for t, j in zip(tau, joints)])
+        tau = np.zeros(len(names))
+        if sel.size:
+            tau[sel] = self._gravity_all()[gidx]
+        limit = eff + np.where(carried, np.abs(tau), 0.0)
         be.set_joint_targets(
-            self.body, q + tau / np.maximum(k, 1e-9), np.zeros(len(joints)) if qd is None else qd,
-            joints=joints, stiffness=k.tolist(), damping=d.tolist(), force_limit=limit.tolist(),
+            self.body, q + tau / np.maximum(k, 1e-9), np.zeros(len(names)) if qd is None else qd,
+            joints=names, stiffness=k_list, damping=d_list, force_limit=limit.tolist(),
         )
 
     def _gravity_torques(self, joints: list[str]) -> np.ndarray:
-        """Gravity holding torques of ``joints`` (0 for hand joints), cached while the robot is still.
-
-        Why the cache: holding still is most of a benchmark's time, and the
-        torques only change when the configuration does (1e-4 rad).
-        """
+        """Gravity holding torques of ``joints`` (0 for hand joints)."""
+        _, _, _, _, _, _, _, sel, gidx, _ = self._drive_plan(tuple(joints))
         tau = np.zeros(len(joints))
-        gj = set(self._gravity_joints())
-        sel = [i for i, j in enumerate(joints) if j in gj]
-        if not sel or self._gravity is None:
-            return tau
-        q = self.joint_positions()
-        if self._gcache is None or np.max(np.abs(q - self._gcache[0])) > 1e-4:
-            names = self._gravity_joints()
-            self._gcache = (q.copy(), dict(zip(names, self._gravity.torques(dict(zip(self.joint_names, q)), names, self._base_rot))))
-        tau[sel] = [self._gcache[1][joints[i]] for i in sel]
+        if sel.size:
+            tau[sel] = self._gravity_all()[gidx]
         return tau
+
+    def _gravity_all(self) -> np.ndarray:
+        """Gravity holding torques of all joints (:attr:`joint_names` order), cached while the robot is still.
+
+        From the backend's own inverse dynamics where it has it
+        (``capabilities.gravity_torques``: microseconds), else from the URDF
+        :class:`GravityModel` (milliseconds; hand joints are not needed and
+        stay 0 there). Why the cache: holding still is most of a benchmark's
+        time, and the torques only change when the configuration does (1e-4 rad).
+        """
+        be = self._require()
+        q = be.get_joint_state(self.body).positions
+        if self._gcache is None or np.max(np.abs(q - self._gcache[0])) > 1e-4:
+            if be.capabilities.gravity_torques:
+                tau = np.asarray(be.gravity_torques(self.body), dtype=float)
+            else:
+                if self._gravity is None:
+                    self._gravity = GravityModel(self.urdf_path, be.config.gravity)
+                names = self._gravity_joints()
+                tau = np.zeros(self.dof)
+                tau[[self.joint_names.index(j) for j in names]] = self._gravity.torques(
+                    dict(zip(self.joint_names, q)), names, self._base_rot)
+            self._gcache = (q.copy(), tau)
+        return self._gcache[1]
 
     def hold(self, joints: Sequence[str] | None = None) -> None:
         """Hold ``joints`` (default: all but the grippers') at their last targets."""
-        js = self._gravity_joints() if joints is None else list(joints)
-        idx = [self.joint_names.index(j) for j in js]
-        self.drive(js, self._targets[idx])
+        if joints is None:
+            self._gravity_joints()
+            js = self._gj
+        else:
+            js = tuple(joints)
+        if js:
+            self.drive(js, self._targets[self._drive_plan(js)[1]])
 
     def step(self, n: int = 1) -> None:
         """Step the backend in control ticks, letting hands re-aim coupled joints each tick."""
