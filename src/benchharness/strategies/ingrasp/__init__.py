@@ -9,8 +9,12 @@ with different costs. See ``docs/ingrasp.md``.
 Modules: :mod:`.config` (settings, variant names), :mod:`.hand` (fingertip
 FK), :mod:`.rotations`, :mod:`.tasks` (published Level I tasks),
 :mod:`.problem` (a task in our hand's frames), :mod:`.planner` (the
-optimiser), :mod:`.strategy` (the plugin object), :mod:`.results` (results
-files). Importing this package is cheap: torch loads in the factories.
+optimiser), :mod:`.strategy` (the plugin object: ``plan_task`` and the
+runner's ``run_trial``), :mod:`.placement` (where our object model sits in
+the initial grasp), :mod:`.execution` (a simulated trial: set-up, execution,
+5 s stability check, drops), :mod:`.results` (results files),
+:mod:`.stiff_plugin` (opt-in ``relaxed-rigidity-stiff``). Importing this
+package is cheap: torch loads in the factories.
 """
 
 from __future__ import annotations

@@ -1,33 +1,76 @@
-"""The strategy object the plugin registrations build: one variant, one hand model."""
+"""The strategy object the plugin registrations build: one variant, one hand model.
+
+``plan_task`` plans offline (the paper's Fig. 6); ``run_trial`` is the
+runner's entry point: plan the task, then execute the plan on the simulated
+Allegro hand holding our model of the task's object (:mod:`.execution`).
+"""
 
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import lru_cache
 from pathlib import Path
 
 from .config import VARIANTS, IngraspConfig
+from .execution import ExecConfig, InGraspExecutor
 from .hand import HandKinematics
 from .planner import PlanResult, plan
 from .problem import InGraspProblem, problem_from_task
-from .tasks import InGraspTask
+from .tasks import InGraspTask, published_tasks
 
-__all__ = ["InGraspPlanner"]
+__all__ = ["InGraspPlanner", "task_for_item"]
+
+
+@lru_cache(maxsize=1)
+def _shared_hand() -> HandKinematics:
+    """One hand model per process (URDF parsing costs more than a plan); trials share it read-only."""
+    return HandKinematics()
+
+
+@lru_cache(maxsize=1)
+def _published_by_id() -> dict[str, InGraspTask]:
+    return {t.task_id: t for t in published_tasks()}
+
+
+def task_for_item(item) -> InGraspTask:
+    """The published Level I task (with its grasp) behind a runner :class:`InhandItem`.
+
+    The task set rows carry only poses; the initial grasp (joints, fingers)
+    lives in the published relaxed-rigidity file, matched on ``task_id``.
+    The item's own ``initial``/``desired`` poses are used (they equal the
+    published ones for ``inhand-level1``).
+    """
+    import numpy as np
+
+    if getattr(item, "level", 1) != 1:
+        raise ValueError(f"in-grasp planners run Level I tasks only, not level {item.level}")
+    tasks = _published_by_id()
+    if item.task_id not in tasks:
+        raise ValueError(f"task {item.task_id!r} has no published Allegro grasp "
+                         f"(tasks/inhand/published/allegro_lvl1_relaxed_rigidity.csv)")
+    t = tasks[item.task_id]
+    return replace(t, initial=np.asarray(item.initial, float), desired=np.asarray(item.desired, float))
 
 
 class InGraspPlanner:
-    """Plans Level I in-grasp trajectories on the Allegro with one variant.
+    """Plans (and, as a runner strategy, executes) Level I in-grasp trajectories on the Allegro.
 
-    The hand model is built once per planner (URDF parsing is slower than a
-    plan); pass ``hand`` to share one between planners.
+    The hand model is built once per process unless ``urdf``/``hand`` is
+    given; ``exec_config`` sets up the simulated trials (:class:`ExecConfig`).
     """
 
+    benchmarks = ("inhand",)
+
     def __init__(self, variant: str = "relaxed-rigidity", config: IngraspConfig | None = None,
-                 urdf: str | Path | None = None, hand: HandKinematics | None = None, **overrides) -> None:
+                 urdf: str | Path | None = None, hand: HandKinematics | None = None,
+                 exec_config: ExecConfig | None = None, **overrides) -> None:
         if variant not in VARIANTS:
             raise ValueError(f"unknown variant {variant!r}; one of {', '.join(VARIANTS)}")
         self.variant = variant
+        self.name = variant
         self.config = replace(config or IngraspConfig(), **overrides)
-        self.hand = hand or HandKinematics(urdf)
+        self.exec_config = exec_config or ExecConfig()
+        self.hand = hand or (HandKinematics(urdf) if urdf is not None else _shared_hand())
 
     def problem(self, task: InGraspTask) -> InGraspProblem:
         return problem_from_task(task, self.hand, self.config.limit_margin)
@@ -37,3 +80,32 @@ class InGraspPlanner:
 
     def plan_task(self, task: InGraspTask) -> PlanResult:
         return self.plan(self.problem(task))
+
+    # ------------------------------------------------------------------ runner
+    def run_trial(self, ctx):
+        """Plan the trial's task, then set up, execute and hold it in ``ctx.backend`` (see :mod:`.execution`)."""
+        import numpy as np
+
+        from benchharness.backends.interface import SimulationError
+        from benchharness.runner.contract import TrialOutcome
+
+        task = task_for_item(ctx.item)
+        problem = self.problem(task)
+        res = self.plan(problem)
+        ctx.check_budget()
+        ctx.recorder.event("plan", variant=self.variant, plan_time_s=round(res.plan_time_s, 4),
+                           planned_reached=np.round(res.reached, 7).tolist(), converged=res.converged)
+        extra = {"variant": self.variant, "planned_reached": np.round(res.reached, 7).tolist(),
+                 "plan_pos_error_cm": round(res.pos_error * 100, 5), "plan_converged": res.converged}
+        executor = InGraspExecutor(self.hand, self.exec_config)
+        try:
+            out = executor.run(ctx.backend, ctx.robot, problem, res, task.object, ctx.rng, ctx.recorder,
+                               duration_s=self.config.duration_s)
+        except SimulationError as exc:  # a blow-up ends this trial with its cause, never the sweep
+            return TrialOutcome(failure="simulator_error", message=f"physics blow-up: {exc}",
+                                plan_time_s=res.plan_time_s, extra=extra)
+        extra.update(out.extra)
+        return TrialOutcome(
+            reached=out.reached, setup=out.setup, dropped=out.dropped, plan_time_s=res.plan_time_s,
+            exec_time_s=out.exec_sim_s, message=out.message, failure="dropped" if out.dropped else None, extra=extra,
+        )
