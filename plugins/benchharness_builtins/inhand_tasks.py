@@ -22,6 +22,14 @@ TASK_SETS = {
         "level3_dmg_tasks.csv",
         "In-hand Level III: contact + pose tasks for a parallel gripper (published DMG.ods)",
     ),
+    "inhand-level1-pivoting": (
+        "level1_pivoting.csv",
+        "In-hand Level I for a parallel gripper: published re-orientations as pivots about the grasp axis",
+    ),
+    "inhand-level2-dmg-regions": (
+        "level2_dmg_regions.csv",
+        "In-hand Level II: desired contact regions only (5 mm discs at the published DMG desired contacts)",
+    ),
 }
 
 

@@ -27,6 +27,12 @@ def _allegro(**kwargs):
     return make_allegro(**kwargs)
 
 
+def _pr2_gripper(**kwargs):
+    from benchharness.robots.pr2_gripper import make_pr2_gripper
+
+    return make_pr2_gripper(**kwargs)
+
+
 @hookimpl
 def benchharness_robots():
     return [
@@ -44,5 +50,9 @@ def benchharness_robots():
             "allegro", _allegro, "Allegro hand v4 (right), 16 joints",
             meta={"dof": 16, "groups": ["index", "middle", "ring", "thumb", "hand"],
                   "urdf": "robots/allegro/allegro.urdf"},
+        ),
+        Registration(
+            "pr2-gripper", _pr2_gripper, "PR2 parallel gripper on a 6-DOF stage (in-hand pivoting / DMG execution)",
+            meta={"dof": 8, "groups": ["stage", "gripper"], "urdf": "robots/pr2_gripper/pr2_gripper.urdf"},
         ),
     ]

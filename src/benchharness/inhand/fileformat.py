@@ -210,7 +210,7 @@ def _parse(path: Path | None, columns: Sequence[str], rows: Sequence[Mapping[str
         out["task_id"].append(p.text("task_id"))
         out["level"].append(p.level())
         poses["initial"][r] = p.pose("initial", True)
-        poses["desired"][r] = p.pose("desired", True)
+        poses["desired"][r] = p.pose("desired", out["level"][-1] != 2)  # Level II: C_d only, no H_d
         if is_results:
             out["method"].append(p.text("method"))
             out["trial"].append(p.integer("trial"))

@@ -17,9 +17,9 @@ __all__ = ["generators", "write_all"]
 
 def generators() -> dict[str, Callable[[], UrdfModel]]:
     """Robot name -> function building its :class:`UrdfModel`."""
-    from . import allegro, herb, pr2
+    from . import allegro, herb, pr2, pr2_gripper
 
-    return {"pr2": pr2.build, "herb": herb.build, "allegro": allegro.build}
+    return {"pr2": pr2.build, "herb": herb.build, "allegro": allegro.build, "pr2_gripper": pr2_gripper.build}
 
 
 def write_all(root: Path) -> list[Path]:

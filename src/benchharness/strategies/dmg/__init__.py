@@ -11,8 +11,11 @@ patches, planned as a shortest path. See ``docs/dmg.md``.
 Modules: :mod:`.config` (parameters), :mod:`.patches` (surface
 discretisation), :mod:`.graph` (construction, "DMG time"), :mod:`.planner`
 (queries, "Plan time"), :mod:`.placement` (published data on our meshes),
-:mod:`.runner` (the strategy object, results files). Importing this package
-is cheap: trimesh/networkx load inside the factory's products.
+:mod:`.runner` (the strategy object, results files), :mod:`.execution`
+(executing plans on a simulator with the ``pr2-gripper``: the strategy's
+``run_trial``), :mod:`.regions` (the Level II task set and the
+contact-region errors of executed trials). Importing this package is cheap:
+trimesh/networkx load inside the factory's products.
 """
 
 from __future__ import annotations
@@ -33,7 +36,8 @@ REGISTRATIONS = [
     Registration(
         "dmg",
         make_planner,
-        "Dexterous Manipulation Graph planner (parallel gripper, Level III)",
-        {"levels": [3], "hand": "parallel gripper (YuMi smart gripper)"},
+        "Dexterous Manipulation Graph planner (parallel gripper, Levels II/III); runs on pr2-gripper",
+        {"levels": [2, 3], "hand": "parallel gripper (YuMi smart gripper model; executed by pr2-gripper)",
+         "benchmarks": ["inhand"]},
     )
 ]

@@ -80,7 +80,18 @@ class DMGPlanner:
     object_configs: Mapping[str, DMGConfig] = field(default_factory=lambda: dict(PUBLISHED_TASK_CONFIGS))
     resolution: float = 0.003
     meshes: Mapping[str, object] = field(default_factory=dict)
+    #: execution on a simulator (``run_trial``): a :class:`.execution.DMGExecConfig`, None = defaults
+    execution: object = None
     _graphs: dict = field(default_factory=dict, repr=False)
+
+    #: the runner may give this strategy in-hand tasks (Levels II and III)
+    benchmarks = ("inhand",)
+
+    def run_trial(self, ctx):
+        """Plan the trial's task and execute the plan with the ``pr2-gripper`` (:mod:`.execution`)."""
+        from .execution import execute_trial
+
+        return execute_trial(self, ctx, self.execution)
 
     def config_for(self, obj: str) -> DMGConfig:
         return {_key(k): v for k, v in self.object_configs.items()}.get(_key(obj), self.config)

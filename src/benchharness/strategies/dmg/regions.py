@@ -1,0 +1,152 @@
+"""Contact regions on our meshes: the Level II task set and the contact-region errors of executed trials.
+
+**Level II tasks** (``tasks/inhand/level2_dmg_regions.csv``, task set
+``inhand-level2-dmg-regions``): the paper's Level II gives the desired
+contact region ``C_d`` only. We derive it from the four published DMG tasks:
+same initial grasp (pose and contacts), no desired hand pose (empty
+columns, level 2), and ``C_d`` = the union of two geodesic discs of radius
+``region_radius`` (:data:`~.runner.DESIRED_REGION_RADIUS`, 5 mm: about half a
+finger pad) on our mesh, centred where the published desired contacts fall
+on our surface along the line through them (the fingers' closing line). The
+disc centres are kept as ``desired_contact1/2`` so the file stays readable
+without meshes; the region is rebuilt on the mesh by :func:`desired_region`.
+
+**Contact-region errors** (:func:`contact_errors`): Algorithm 1
+(:func:`benchharness.metrics.contact.contact_region_error`) between ``C_d``
+and the two finger pads as they touched the object at the end of the trial
+(5 mm geodesic discs around the measured contact points,
+:data:`~.runner.FINGER_PAD_RADIUS`), on our mesh placed in the task frame --
+the same construction :func:`.runner.results_for_grasps` uses for planned
+grasps, so planned and executed figures compare. The runner scores poses
+only; :func:`score_store` adds G_euc / G_geo / G_min to stored trials.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["REGION_TASK_FILE", "derive_region_tasks", "write_region_tasks", "desired_region", "contact_errors",
+           "score_store"]
+
+REGION_TASK_FILE = "level2_dmg_regions.csv"
+
+
+def derive_region_tasks(level3_path: str | Path | None = None):
+    """The Level II :class:`~benchharness.inhand.records.TaskSet` from the published DMG tasks."""
+    from ...inhand.fileformat import read_tasks
+    from ...inhand.records import TaskSet
+    from ...paths import tasks_dir
+    from .runner import DESIRED_REGION_RADIUS
+
+    src = read_tasks(Path(level3_path) if level3_path else tasks_dir() / "inhand" / "level3_dmg_tasks.csv")
+    n = len(src)
+    return TaskSet(
+        task_id=np.array([f"{t}-region" for t in src.task_id], dtype=object),
+        object=src.object.copy(),
+        level=np.full(n, 2),
+        initial=src.initial.copy(),
+        desired=np.full((n, 7), np.nan),
+        contacts={k: v[:, :2].copy() for k, v in src.contacts.items()},
+        extra={
+            "source_task": np.array([str(t) for t in src.task_id], dtype=object),
+            "region_radius": np.array([f"{DESIRED_REGION_RADIUS:g}"] * n, dtype=object),
+            "set": np.array(["dmg-level2-regions"] * n, dtype=object),
+        },
+    )
+
+
+def write_region_tasks(path: str | Path | None = None) -> Path:
+    from ...inhand.fileformat import write_tasks
+    from ...paths import tasks_dir
+
+    path = Path(path) if path else tasks_dir() / "inhand" / REGION_TASK_FILE
+    write_tasks(derive_region_tasks(), path)
+    return path
+
+
+def _mesh_in_task_frame(obj: str, planner=None):
+    from .runner import DMGPlanner
+
+    planner = planner or DMGPlanner()
+    return planner.placement(obj).mesh_in_published(planner.mesh_for(obj))
+
+
+def desired_region(mesh, desired_contacts: np.ndarray, radius: float) -> np.ndarray:
+    """Vertex indices of ``C_d``: geodesic discs of ``radius`` around the desired contacts put on ``mesh``
+    along the line through them."""
+    from ...objects import contact_region
+    from .planner import surface_contacts
+
+    c = np.asarray(desired_contacts, float)[:2]
+    z = c[1] - c[0]
+    on, _ = surface_contacts(mesh, c, z / np.linalg.norm(z))
+    verts: set[int] = set()
+    for p in on:
+        verts.update(contact_region(mesh, p, radius, metric="geodesic").vertices.tolist())
+    return np.array(sorted(verts), dtype=np.int64)
+
+
+def contact_errors(obj: str, desired_contacts, reached_contacts, *, radius: float | None = None,
+                   pad_radius: float | None = None, planner=None, method: str = "heat") -> dict[str, float]:
+    """G_euc, G_geo, G_min (m) of one trial, all in the task frame (see the module docstring)."""
+    from ...metrics.contact import contact_region_error
+    from ...objects import contact_region
+    from .runner import DESIRED_REGION_RADIUS, FINGER_PAD_RADIUS
+
+    mesh = _mesh_in_task_frame(obj, planner)
+    region = desired_region(mesh, desired_contacts, DESIRED_REGION_RADIUS if radius is None else radius)
+    pads = [contact_region(mesh, np.asarray(c, float), FINGER_PAD_RADIUS if pad_radius is None else pad_radius,
+                           metric="geodesic").mesh for c in np.asarray(reached_contacts, float)]
+    err = contact_region_error(mesh, region, pads, method=method)
+    return {"g_euc": float(err.euc), "g_geo": float(err.geo), "g_min": float(err.g_min)}
+
+
+def score_store(store: str | Path, task_names: tuple[str, ...] = ("inhand-level3-dmg", "inhand-level2-dmg-regions")) -> list[dict[str, Any]]:
+    """Contact-region errors of every stored DMG trial of ``task_names`` with reached contacts.
+
+    Returns one dict per trial: task, backend, trial index, task id,
+    object, status and G_euc / G_geo / G_min (m). The desired contacts come
+    from the task set registered under the stored task name.
+    """
+    import json
+    import sqlite3
+
+    from ...plugin import get_manager
+
+    tasks = {}
+    out = []
+    con = sqlite3.connect(str(store))
+    try:
+        rows = con.execute("select task, backend, strategy, trial_index, status, outcome_json from trials "
+                           "order by task, backend, trial_index").fetchall()
+    finally:
+        con.close()
+    for task, backend, strategy, idx, status, oj in rows:
+        if task not in task_names:
+            continue
+        o = json.loads(oj or "{}")
+        rc = o.get("reached_contacts")
+        row: dict[str, Any] = {"task": task, "backend": backend, "strategy": strategy, "trial": idx,
+                               "task_id": o.get("task_id"), "object": o.get("object"), "status": status}
+        if rc and status == "success":
+            if task not in tasks:
+                ts = get_manager().create("task", task)
+                tasks[task] = {str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)}
+            row.update(contact_errors(o["object"], tasks[task][o["task_id"]], rc))
+        out.append(row)
+    return out
+
+
+if __name__ == "__main__":  # python -m benchharness.strategies.dmg.regions [STORE]: write the task file, or score a store
+    import sys
+
+    if len(sys.argv) > 1:
+        for r in score_store(sys.argv[1]):
+            g = {k: (f"{r[k] * 100:.3f} cm" if k in r else "—") for k in ("g_euc", "g_geo", "g_min")}
+            print(f"{r['task']:28s} {r['backend']:9s} trial {r['trial']:2d} {r['task_id']:32s} {r['status']:9s} "
+                  f"G_euc {g['g_euc']}  G_geo {g['g_geo']}  G_min {g['g_min']}")
+    else:
+        print(write_region_tasks())
