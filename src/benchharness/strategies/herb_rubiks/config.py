@@ -1,0 +1,127 @@
+"""Parameters of HERB's push-grasp Rubik's strategy: scene, hand pre-shapes, the push, and every error source.
+
+Every magnitude is a named field with its default and why. ``zero_error()``
+gives the same configuration with every injected error 0 (tests, and telling
+the strategy's own mistakes from injected ones).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+__all__ = ["ErrorConfig", "HerbPushGraspConfig"]
+
+
+@dataclass(frozen=True)
+class ErrorConfig:
+    """Injected errors, each drawn from the strategy's ``ctx.rng`` (same model as the PR2 baselines').
+
+    * **Arm calibration offset** (per arm, fixed for the trial): the arm
+      reaches ``offset * commanded``; a WAM's calibration to the head camera
+      is good to a few mm.
+    * **Actuator tracking noise** (per motion): each commanded tool pose is
+      perturbed by an independent Gaussian translation the strategy never sees.
+    * **Camera noise**: the head camera's one-shot estimate of the cube on the
+      table (``benchharness.sensors.HeadCamera`` defaults when importable,
+      else the fallback figures below). After that the belief only changes by
+      dead reckoning and by push-grasp contacts.
+    """
+
+    #: std of each arm's fixed calibration offset, per world axis (m).
+    calib_pos_std: float = 0.0015
+    #: std of each arm's fixed calibration rotation, per world axis (deg).
+    calib_rot_std_deg: float = 0.5
+    #: std of the per-motion tracking error of a commanded tool pose, per world axis (m).
+    tracking_std: float = 0.001
+    #: fallback camera noise when benchharness.sensors is absent: position std (m), yaw std (deg)
+    camera_pos_std: float = 0.003
+    camera_yaw_std_deg: float = 2.0
+    #: use the head camera at all (False = the initial estimate is the true pose)
+    camera: bool = True
+
+    def zero(self) -> "ErrorConfig":
+        return ErrorConfig(**{f.name: (False if f.name == "camera" else 0.0) for f in fields(self)})
+
+    @property
+    def is_zero(self) -> bool:
+        return not self.camera and all(getattr(self, f.name) == 0.0 for f in fields(self) if f.name != "camera")
+
+
+@dataclass(frozen=True)
+class HerbPushGraspConfig:
+    """Scene, pre-shapes, push and motion settings (metres, seconds, radians, newtons)."""
+
+    #: table top height (m): the cube's middle (0.9285 m) is a short reach below HERB's home hands
+    #: (1.03 m). Lower (0.80 m) the side pick needs WAM joint 2 at its 2.0 rad limit, where the arm sags
+    #: 2-3 cm under gravity.
+    table_height: float = 0.90
+    #: half extents (x, y) of the table top (m): narrow in y so that the picking palm and the
+    #: thumb's root pass beside it.
+    table_half_size: tuple[float, float] = (0.10, 0.04)
+    #: cube centre on the table, robot base frame (x forward, y left): between the two WAMs.
+    cube_xy: tuple[float, float] = (0.60, 0.0)
+    #: cube centre while twisting (robot base frame); both WAMs reach every push-grasp and hand-over
+    #: turn there (measured, SAPIEN, Rubiks-1-5 trial 1). 25 cm above the table top: at 10 cm a giver
+    #: turning the cube in front, pinch axis vertical, put a finger (75 mm off the palm axis at spread
+    #: 90 deg) on the table. 75 cm forward: nearer (58-68 cm) a giver in front needs WAM joint 2 at its
+    #: 2.0 rad limit, where link 3 meets link 1 and the arm stops 4-6 cm short.
+    twist_position: tuple[float, float, float] = (0.75, 0.0, 1.15)
+    #: spread of F1/F2 (rad): 90 deg puts the outer fingers face to face across the tool x axis.
+    spread: float = math.pi / 2
+    #: thumb (F3, the "middle finger") flex of the rotator's pre-shape (rad). Its tip then stands
+    #: ~33 mm beyond the tool frame: on contact the closing outer fingers (which pinch ~43 mm beyond
+    #: it) land ~10 mm deep, on the middle of the outer slab (0-19 mm).
+    rotator_thumb_flex: float = 0.55
+    #: thumb flex of the holder's pre-shape (rad): tip ~16 mm beyond the tool frame, pinch ~27 mm
+    #: deep, on the middle slab (19-38 mm); the holder's own outer slab is pressed by the thumb.
+    holder_thumb_flex: float = 0.70
+    #: the tool frame stands this far off the face's centre towards the thumb's root (m, tool +y), so
+    #: that the thumb's tip (which curls ~16 mm past the palm axis at the rotator's flex) meets the face
+    #: inside its edge. The holder's more flexed thumb curls ~29 mm past the axis: beyond the 28.5 mm
+    #: half face, so its hand sits 12 mm off centre.
+    rotator_thumb_offset: float = 0.0
+    holder_thumb_offset: float = 0.012
+    #: joint torque cap of the thumb while it probes (N m): stiff enough not to fold at the stop force.
+    thumb_force: float = 2.0
+    #: speed of the push along the face normal (m/s): slow, so the stop overshoots < 0.5 mm.
+    approach_speed: float = 0.03
+    #: summed normal force between the hand and the cube that counts as contact (N).
+    contact_force: float = 1.0
+    #: the push starts this far before the believed contact (m): > 3 sigma of the belief's error.
+    push_start: float = 0.03
+    #: and gives up this far past it (m): no face there means the cube is not where believed.
+    push_limit: float = 0.03
+    #: in a hand-over the giver straightens its thumb once the taker's thumb is on the taker's face, before
+    #: the taker closes, to clear the taker's crossing outer finger. Off: without the thumb a two-finger
+    #: pinch is a hinge, and the cube swung 20-32 deg about it (measured, SAPIEN); see taker_parallel.
+    giver_retracts_thumb: bool = False
+    #: in a hand-over the taker pinches the same pair of faces as the giver (True) rather than crossing
+    #: it (the PR2's rule): crossing puts the taker's outer finger through the giver's curled thumb.
+    taker_parallel: bool = True
+    #: joint torque cap of the outer fingers when closing (N m).
+    grip_torque: float = 2.0
+    #: closing speed of the outer fingers' command (rad/s).
+    finger_speed: float = 1.5
+    #: stand-off the arm swings round at before a push (m), along the approach from the believed contact.
+    far_distance: float = 0.15
+    #: retreat along the approach after letting go (m).
+    retreat_distance: float = 0.08
+    #: duration of one quarter turn of the wrist (WAM joint 7) (s).
+    quarter_turn_s: float = 1.0
+    #: joint-speed fraction for arm motions.
+    velocity_scale: float = 0.4
+    #: waypoints per quarter turn when the giver turns the cube in a hand-over.
+    handover_waypoints: int = 4
+    #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).
+    max_waypoint_jump: float = 2.5
+    #: a motion that ends farther than this from its target is logged as a warning event (m).
+    reach_warning: float = 0.005
+    #: the cube counts as dropped if it ends below the table top + 1 cm and this far from the belief (m).
+    drop_distance: float = 0.05
+    #: stop after this many plan actions (None: the whole plan); for tests and debugging.
+    max_actions: int | None = None
+    errors: ErrorConfig = ErrorConfig()
+
+    def zero_error(self) -> "HerbPushGraspConfig":
+        return replace(self, errors=self.errors.zero())

@@ -1,0 +1,82 @@
+"""HERB tool frames for push-grasps, from an *estimated* cube pose (no physics).
+
+HERB's tool frame ``{l,r}_bh_tcp`` has z = approach (out of the palm) and
+y towards the thumb (F3); with the spread at 90 deg the outer fingers F1/F2
+face each other across tool x. The PR2 baselines' frames
+(:mod:`benchharness.strategies.pr2_rubiks.frames`) are robot-independent
+grip geometry with x = approach and y = the finger axis, so a HERB grip is
+that frame turned by :data:`HERB_FROM_PR2`: HERB z = PR2 x (approach),
+HERB x = PR2 y (the pinch axis), HERB y = PR2 z.
+
+A push-grasp of a face puts the tool frame on the face's outward normal at
+``half edge + face_depth`` from the centre, where ``face_depth`` is how far
+beyond the tool frame the thumb's tip stands in the pre-shape: that is where
+the tool frame will be when the thumb touches the face.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ...geometry import Pose
+from ..pr2_rubiks.frames import DIRECTIONS, grip_candidates, rotate_about_point
+
+__all__ = ["CUBE_HALF", "DIRECTIONS", "HERB_FROM_PR2", "approach_axis", "pinch_axis", "push_grip_candidates",
+           "reanchor_along_approach", "rotate_about_point", "rolled_about_approach", "thumb_face_depth"]
+
+CUBE_HALF = 0.0285
+#: rotation PR2 tool frame -> HERB tool frame (columns: HERB axes in PR2 tool coordinates)
+HERB_FROM_PR2 = Rotation.from_matrix(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]))
+#: BarrettHand distal link box (robots/descriptions/herb.py: 22 x 14 mm, 49 mm long, from 3 mm past
+#: the distal joint), corners in the link frame
+_DIST_LEN = 0.055
+_DIST_CORNERS = np.array([[sx * 0.011, sy * 0.007, 0.003 + sz] for sx in (-1, 1) for sy in (-1, 1)
+                          for sz in (0.0, _DIST_LEN - 0.006)])
+
+
+def approach_axis(tool: Pose) -> np.ndarray:
+    return tool.rotation.apply([0.0, 0.0, 1.0])
+
+
+def pinch_axis(tool: Pose) -> np.ndarray:
+    """World direction across which the outer fingers F1/F2 pinch (tool x)."""
+    return tool.rotation.apply([1.0, 0.0, 0.0])
+
+
+def push_grip_candidates(cube: Pose, world_dir: str, face_depth: float) -> list[Pose]:
+    """The four push-grasp tool frames on the face nearest ``world_dir`` (pinch across either face pair, either way)."""
+    return [Pose.from_rotation(p.p, p.rotation * HERB_FROM_PR2)
+            for p in grip_candidates(cube, world_dir, CUBE_HALF + face_depth)]
+
+
+def rolled_about_approach(tool: Pose, angle: float) -> Pose:
+    """The tool frame after a wrist roll (WAM joint 7, about tool z through the tool origin)."""
+    return Pose.from_rotation(tool.p, tool.rotation * Rotation.from_rotvec([0.0, 0.0, angle]))
+
+
+def thumb_face_depth(tool: Pose, distal: Pose) -> float:
+    """How far beyond the tool frame, along the approach, the thumb's distal link reaches (m).
+
+    ``tool`` and ``distal`` are the tool-frame and thumb-distal-link poses
+    (from the robot's own joint readings): a face perpendicular to the approach
+    is first touched by the distal link's corner that reaches farthest.
+    """
+    corners = distal.rotation.apply(_DIST_CORNERS) + distal.p
+    local = tool.rotation.inv().apply(corners - tool.p)
+    return float(np.max(local[:, 2]))
+
+
+def reanchor_along_approach(belief: Pose, tool_at_contact: Pose, face_depth: float) -> tuple[Pose, float]:
+    """The belief moved along the approach so that its near face is where the thumb touched; and the shift (m).
+
+    The push stopped when the thumb's tip, ``face_depth`` beyond the
+    (believed) tool frame along its z, touched the face: the face's distance
+    along the approach is known from the hand alone. Only that one component
+    of the belief changes; across the approach the push tells nothing.
+    """
+    z = approach_axis(tool_at_contact)
+    face_seen = float(np.dot(tool_at_contact.p, z)) + face_depth
+    face_believed = float(np.dot(belief.p, z)) - CUBE_HALF
+    shift = face_seen - face_believed
+    return Pose(belief.p + shift * z, belief.q), shift
