@@ -106,12 +106,17 @@ def box_plot(
     axes[-1].set_xticks(np.arange(len(groups)))
     axes[-1].set_xticklabels(groups, rotation=30, ha="right")
     axes[-1].set_xlabel(group_col)
+    # As many legend columns as fit the figure width (long "method (robot, backend)" labels
+    # would otherwise run off the canvas), and room above the panels for its rows.
+    longest = max((len(str(h)) for h in hues), default=1)
+    ncol = max(1, min(len(hues), 5, int(fig.get_figwidth() * 72 / (6.5 * longest + 40))))
+    rows = -(-len(hues) // ncol)
     fig.legend(
         handles=[Patch(facecolor=c, alpha=0.75, label=h) for h, c in zip(hues, colours)],
-        loc="upper center", ncol=min(len(hues), 5), frameon=False,
+        loc="upper center", ncol=ncol, frameon=False,
         title=title,
     )
-    fig.tight_layout(rect=(0, 0, 1, 1 - 0.5 / fig.get_figheight()))
+    fig.tight_layout(rect=(0, 0, 1, 1 - (0.3 + 0.25 * rows) / fig.get_figheight()))
     if path is not None:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -246,8 +246,14 @@ def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
 
 
 def inhand_table3(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
-    """Per method: per task, median metrics over its trials, with the paper's DMG figures by object."""
+    """Per method: per task, median metrics over its trials, with the paper's DMG figures by object.
+
+    Only Level II/III trials: the paper's per-task table is for contact tasks;
+    Level I methods are summarised by Table II. Trials stored without a level
+    (older stores) are kept.
+    """
     scored, _ = _scorable(trials)
+    scored = [t for t in scored if t.outcome.get("level") in (None, 2, 3)]
     if not scored:
         return []
     columns, col_of = _columns(scored)
