@@ -20,6 +20,8 @@ def check_fk_against_backend(robot, backend, n: int = 4, seed: int = 0) -> None:
     gen = torch.Generator().manual_seed(seed)
     lo = np.array([robot.urdf_joints[j].lower for j in robot.joint_names])
     hi = np.array([robot.urdf_joints[j].upper for j in robot.joint_names])
+    # continuous joints (PR2 forearm/wrist roll) have no limits: sample them over two turns
+    lo, hi = np.where(np.isfinite(lo), lo, -2 * np.pi), np.where(np.isfinite(hi), hi, 2 * np.pi)
     base = backend.get_link_pose(robot.body, None)
     for _ in range(n):
         q = (lo + torch.rand(len(lo), generator=gen, dtype=torch.float64).numpy() * (hi - lo))

@@ -36,7 +36,8 @@ def test_collision_only_primitives_no_mimic(name):
     assert len(movable) == DOF[name]
     for j in movable:
         lim = j.find("limit")
-        assert float(lim.get("lower")) < float(lim.get("upper"))
+        if j.get("type") != "continuous":  # a continuous joint has no position limits
+            assert float(lim.get("lower")) < float(lim.get("upper"))
         assert float(lim.get("velocity")) > 0 and float(lim.get("effort")) > 0
 
 
@@ -86,6 +87,12 @@ def test_pr2_published_figures():
     # the gripper opens to 90 mm: two fingers of travel t, each pad 1 mm off the joint value
     f = j["l_gripper_l_finger_joint"].find("limit")
     assert 2 * float(f.get("upper")) + 2 * 0.001 == pytest.approx(0.09)
+    # forearm and wrist roll are continuous, as in pr2_description (no position limits)
+    for side in "lr":
+        for name in ("forearm_roll", "wrist_roll"):
+            joint = j[f"{side}_{name}_joint"]
+            assert joint.get("type") == "continuous"
+            assert joint.find("limit").get("lower") is None and joint.find("limit").get("upper") is None
 
 
 def test_allegro_published_figures():

@@ -67,6 +67,8 @@ class RobotArm:
         self.upper = np.array([jl[j].upper for j in config.joints])
         self.max_velocity = np.array([jl[j].velocity for j in config.joints])
         self.effort = np.array([jl[j].effort for j in config.joints])
+        #: URDF ``continuous`` joints (e.g. the PR2's forearm and wrist roll): no limits, any 2*pi-branch
+        self.continuous = np.array([jl[j].type == "continuous" for j in config.joints], dtype=bool)
 
     @property
     def name(self) -> str:
@@ -105,14 +107,104 @@ class RobotArm:
         seed: int = 0,
         config: IKConfig | None = None,
     ) -> IKResult:
-        """Batched IK for tool-frame targets in the base-link frame (see :meth:`KinematicChain.ik`)."""
+        """Batched IK for tool-frame targets in the base-link frame (see :meth:`KinematicChain.ik`).
+
+        With ``seed_q``, continuous joints come back on the 2*pi-branch nearest
+        the seed (see :meth:`_ik_continuous`), so that a motion from the
+        current configuration never unwinds a full turn.
+        """
         cfg = config or self.robot.ik_config
         if self.config.position_only:
             from dataclasses import replace
 
             cfg = replace(cfg, rot_tolerance=float("inf"))
             return self._ik_position(targets, seed_q, generator, seed, cfg)
+        if seed_q is not None and self.continuous.any():
+            return self._ik_continuous(targets, seed_q, generator, seed, cfg)
         return self.chain.ik(targets, seed_q=seed_q, generator=generator, seed=seed, config=cfg)
+
+    def _ik_continuous(self, targets, seed_q, generator, seed, cfg) -> IKResult:
+        """IK with continuous joints, returned on the 2*pi-branch nearest ``seed_q``.
+
+        Why: :class:`KinematicChain` searches a continuous joint over [-pi, pi]
+        (it needs finite bounds to sample and clamp), but the joint itself may
+        be anywhere, e.g. 3.5 rad after a twist, and a solution just past the
+        window's edge is unreachable from a seed near it (the descent is
+        clamped there and a restart on another arm branch wins: measured as a
+        2.5 rad swing of three joints in one hand-over waypoint). So the
+        problem is re-centred on the seed first:
+
+        * the *last* joint, if continuous: turning it by ``c`` is a fixed
+          transform of the tip, ``G(c) = FK(q|last=0)^-1 FK(q|last=c)``, so
+          the solver gets the target ``T G(-c)`` with the seed's last joint
+          at 0, and ``c`` (the seed's value) is added back;
+        * any other continuous joint: its window is moved by pi when the
+          seed lies in the outer half of [-pi, pi], by solving on a copy of
+          the chain whose joint origin is turned by pi about the joint axis
+          (``origin * Rot(axis, pi) * Rot(axis, q') = origin * Rot(axis, q' + pi)``).
+
+        Each solution is then unwrapped by the multiple of 2*pi that brings it
+        nearest the seed.
+        """
+        from ..kinematics import IKResult
+
+        t = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
+        b, dof = t.shape[0], len(self.joints)
+        ref = np.broadcast_to(np.asarray(seed_q, dtype=float).reshape(-1, dof), (b, dof)).copy()
+        c = self.continuous
+        mid = np.flatnonzero(c[:-1])
+        shift = np.zeros((b, dof))
+        if c[-1]:
+            shift[:, -1] = ref[:, -1]
+        wrapped_mid = (ref[:, mid] + np.pi) % (2 * np.pi) - np.pi
+        shift[:, mid] = np.where(np.abs(wrapped_mid) > np.pi / 2, np.pi, 0.0)
+        if c[-1]:
+            q0 = ref.copy()
+            q0[:, -1] = 0.0
+            qc = ref.copy()
+            qc[:, -1] = -shift[:, -1]
+            m = self.chain.fk(np.concatenate([q0, qc]))
+            t = t @ (np.linalg.inv(m[:b]) @ m[b:])  # G(-c), in the tip frame
+        local = ref - shift
+        local[:, c] = (local[:, c] + np.pi) % (2 * np.pi) - np.pi
+        q = np.zeros((b, dof))
+        ok, dp, dr = np.zeros(b, dtype=bool), np.zeros(b), np.zeros(b)
+        keys = [tuple(bool(x) for x in shift[i, mid] != 0.0) for i in range(b)]
+        for key in sorted(set(keys)):
+            rows = np.array([i for i in range(b) if keys[i] == key])
+            chain = self._recentred_chain(tuple(int(j) for j, on in zip(mid, key) if on))
+            res = chain.ik(t[rows], seed_q=local[rows], generator=generator, seed=seed, config=cfg)
+            q[rows], ok[rows], dp[rows], dr[rows] = res.q, res.success, res.pos_error, res.rot_error
+        q = q + shift
+        q[:, c] += 2 * np.pi * np.round((ref[:, c] - q[:, c]) / (2 * np.pi))
+        return IKResult(q, ok, dp, dr)
+
+    def _recentred_chain(self, turned: tuple[int, ...]) -> KinematicChain:
+        """The arm's chain with the origins of joints ``turned`` (indices) turned by pi about their axes."""
+        if not turned:
+            return self.chain
+        cache = self.__dict__.setdefault("_recentred", {})
+        if turned not in cache:
+            import xml.etree.ElementTree as ET
+
+            from scipy.spatial.transform import Rotation
+
+            root = ET.fromstring(self.robot.urdf_text)
+            names = {self.joints[i] for i in turned}
+            for j in root.findall("joint"):
+                if j.get("name") not in names:
+                    continue
+                origin = j.find("origin")
+                if origin is None:
+                    origin = ET.SubElement(j, "origin")
+                rpy = [float(x) for x in (origin.get("rpy") or "0 0 0").split()]
+                axis_el = j.find("axis")
+                axis = np.array([float(x) for x in (axis_el.get("xyz") if axis_el is not None else "1 0 0").split()])
+                r = Rotation.from_euler("xyz", rpy) * Rotation.from_rotvec(np.pi * axis / np.linalg.norm(axis))
+                origin.set("rpy", " ".join(repr(float(x)) for x in r.as_euler("xyz")))
+            cache[turned] = KinematicChain(ET.tostring(root, encoding="unicode"), self.config.base_link,
+                                           self.config.tcp_link)
+        return cache[turned]
 
     def _ik_position(self, targets, seed_q, generator, seed, cfg) -> IKResult:
         """Position-only IK: the target orientation is replaced by the one the chain reaches.
@@ -166,15 +258,18 @@ class RobotArm:
         settle: float = 0.3,
         generator: torch.Generator | None = None,
         seed: int = 0,
+        seed_q: np.ndarray | None = None,
     ) -> MotionResult:
         """Move the tool frame to a world pose: IK for the goal, then a tracked joint trajectory.
 
         The IK is seeded with the current joint positions, so the arm takes
-        the solution nearest to where it is.
+        the solution nearest to where it is; or with ``seed_q``, a
+        configuration planned ahead (e.g. the start of a chain of solutions
+        checked for a later motion), so that the arm ends on that branch.
         """
         base = self.base_pose()
         local = (base.inv() * target).as_matrix()
-        q_now = self.positions()
+        q_now = self.positions() if seed_q is None else np.asarray(seed_q, dtype=float)
         res = self.ik(local[None], seed_q=q_now, generator=generator, seed=seed)
         motion = self.move_to_joints(res.q[0], duration=duration, velocity_scale=velocity_scale, settle=settle)
         reached = self.tcp_pose()

@@ -11,9 +11,11 @@ Simplifications (also in robots/pr2/README.md):
 * the gripper is two prismatic fingers (the real one is a four-bar linkage
   whose pads stay parallel); the fingers are coupled in the controller, not
   by ``<mimic>`` (PhysX has no mimic joints);
-* forearm roll and wrist roll are continuous on the robot; they are bounded
-  to +/-pi here so that IK and trajectories see finite limits (every
-  orientation is still reachable);
+* forearm roll and wrist roll are ``continuous``, as on the robot: a twist
+  or a hand-over turn can carry on past +/-pi without the arm having to
+  switch IK branch (unwind) mid-turn. IK searches them over +/-pi and
+  ``RobotArm.ik`` unwraps each solution to the 2*pi-branch nearest the seed;
+  PyBullet and SAPIEN load them as unlimited revolute joints;
 * no head, no laser tilt, no casters: the base is one fixed box.
 """
 
@@ -87,17 +89,19 @@ def _arm(m: UrdfModel, side: str) -> None:
     m.link(f"{s}_elbow_flex_link", [Geom("sphere", (0.05,))], 1.90327,
            source="mass 1.90327 kg (upper_arm_v0/upper_arm.urdf.xacro)")
     m.joint(
-        f"{s}_forearm_roll_joint", "revolute", f"{s}_elbow_flex_link", f"{s}_forearm_roll_link",
-        axis=(1, 0, 0), lower=-math.pi, upper=math.pi, effort=30, velocity=VSCALE * 6, damping=0.1,
-        source="axis x, effort 30, velocity 0.6*6 (upper_arm_v0/upper_arm.urdf.xacro); continuous there, bounded to +-pi here",
+        f"{s}_forearm_roll_joint", "continuous", f"{s}_elbow_flex_link", f"{s}_forearm_roll_link",
+        axis=(1, 0, 0), effort=30, velocity=VSCALE * 6, damping=0.1,
+        source="continuous, axis x, effort 30, velocity 0.6*6 (upper_arm_v0/upper_arm.urdf.xacro)",
     )
     m.link(f"{s}_forearm_roll_link", mass=0.1, point_mass_radius=0.02,
            source="0.1 kg placeholder mass as in pr2_description; inertia of a 2 cm solid sphere")
     m.joint(f"{s}_forearm_joint", "fixed", f"{s}_forearm_roll_link", f"{s}_forearm_link",
             source="fixed, origin 0 (forearm_v0/forearm.urdf.xacro via arm macro)")
     m.link(
-        f"{s}_forearm_link", [Geom("box", (0.15, 0.08, 0.08), (0.195, 0.0, 0.0))], 2.57968,
-        source="mass 2.57968 kg, COM x 0.188 (forearm_v0/forearm.urdf.xacro); box x 0.12..0.27 m",
+        f"{s}_forearm_link", [Geom("box", (0.12, 0.08, 0.08), (0.18, 0.0, 0.0))], 2.57968,
+        source="mass 2.57968 kg, COM x 0.188 (forearm_v0/forearm.urdf.xacro); box x 0.12..0.24 m "
+        "(ends 0.081 m short of the wrist flex axis, where the real forearm tapers, so that the full -2.094 rad "
+        "wrist flex is collision-free with the palm at any wrist roll)",
     )
     m.joint(
         f"{s}_wrist_flex_joint", "revolute", f"{s}_forearm_link", f"{s}_wrist_flex_link",
@@ -108,9 +112,9 @@ def _arm(m: UrdfModel, side: str) -> None:
     m.link(f"{s}_wrist_flex_link", [Geom("sphere", (0.035,))], 0.61402,
            source="mass 0.61402 kg (forearm_v0/forearm.urdf.xacro)")
     m.joint(
-        f"{s}_wrist_roll_joint", "revolute", f"{s}_wrist_flex_link", f"{s}_wrist_roll_link",
-        axis=(1, 0, 0), lower=-math.pi, upper=math.pi, effort=10, velocity=VSCALE * 6, damping=0.1,
-        source="axis x, effort 10, velocity 0.6*6 (forearm_v0/forearm.urdf.xacro); continuous there, bounded to +-pi here",
+        f"{s}_wrist_roll_joint", "continuous", f"{s}_wrist_flex_link", f"{s}_wrist_roll_link",
+        axis=(1, 0, 0), effort=10, velocity=VSCALE * 6, damping=0.1,
+        source="continuous, axis x, effort 10, velocity 0.6*6 (forearm_v0/forearm.urdf.xacro)",
     )
     m.link(f"{s}_wrist_roll_link", mass=0.1, point_mass_radius=0.02,
            source="0.1 kg placeholder mass as in pr2_description; inertia of a 2 cm solid sphere")
@@ -173,9 +177,10 @@ def build() -> UrdfModel:
         source="origin -0.05 0 0.739675, limits 0..0.33 m, effort 10000, velocity 0.013 (torso_v0/torso.urdf.xacro)",
     )
     m.link(
-        "torso_lift_link", [Geom("box", (0.20, 0.24, 0.80), (-0.075, 0.0, -0.25))], 36.248046,
+        "torso_lift_link", [Geom("box", (0.20, 0.14, 0.80), (-0.075, 0.0, -0.25))], 36.248046,
         source="mass 36.248046 kg (torso_v0/torso.urdf.xacro); column box stands in for the torso mesh, "
-        "its front face 0.025 m ahead of the shoulder pan axes so that the shoulders can pan inwards",
+        "its front face 0.025 m ahead of the shoulder pan axes and 0.14 m wide (the 0.376 m between the "
+        "shoulder pan axes is shoulder, not column) so that the shoulders pan fully inwards without touching it",
     )
     _arm(m, "l")
     _arm(m, "r")

@@ -64,6 +64,11 @@ class DeadReckoningStrategy:
 
     benchmarks = ("rubiks",)
     name = "dead-reckoning"
+    #: where the fingers need not cross the other hand's: "crossing" prefers crossing them,
+    #: "parallel" prefers closing along the other hand's pad axis (no torque about it)
+    finger_preference = "parallel"
+    #: extra IK seeds (random self-motions of the arm) a giver's grip is also solved from
+    giver_seeds = 6
 
     def __init__(self, config: PR2RubiksConfig | None = None) -> None:
         self.config = config or PR2RubiksConfig()
@@ -184,16 +189,31 @@ class DeadReckoningStrategy:
         if true.p[2] < self.config.table_height + CUBE_HALF + 0.01 and np.linalg.norm(true.p - self.est.p) > self.config.drop_distance:
             raise StrategyFailure("dropped", f"action {k + 1}: the cube fell (at {np.round(true.p, 3).tolist()})")
 
+    def _judge(self, label: str, hand: Hand | None = None) -> None:
+        """Diagnostic event (not control): how far the true cube is from the belief right now.
+
+        Recorded after every grasp and at the steps of a hand-over, so that a
+        failure's record says at which step the cube moved in a grip.
+        """
+        true = self.cube.pose()
+        rv = (true.rotation * self.est.rotation.inv()).as_rotvec()
+        data = {"label": label, "err_mm": round(float(1000 * np.linalg.norm(true.p - self.est.p)), 2),
+                "rot_deg": np.round(np.degrees(rv), 1).tolist()}
+        if hand is not None and hand.cmd is not None:
+            data["hand"] = hand.side
+            data["fingers"] = np.round(hand.cmd.rotation.apply([0.0, 1.0, 0.0]), 2).tolist()
+        self.ctx.recorder.event("check", **data)
+
     # ------------------------------------------------------------- motion
     def _send(self, hand: Hand, target: Pose, *, label: str, duration: float | None = None,
-              settle: float = 0.2) -> None:
+              settle: float = 0.2, seed_q: np.ndarray | None = None) -> None:
         """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors."""
         err = self.config.errors
         noise = self.ctx.rng.normal(0.0, err.tracking_std, 3) if err.tracking_std else np.zeros(3)
         cal = hand.calibration
         actual = Pose.from_rotation(target.p + cal.p + noise, cal.rotation * target.rotation)
         res = hand.arm.move_to_pose(actual, duration=duration, velocity_scale=self.config.velocity_scale,
-                                    settle=settle)
+                                    settle=settle, seed_q=seed_q)
         hand.cmd = target
         if hand.holding:
             hand.last_grip = target
@@ -209,17 +229,23 @@ class DeadReckoningStrategy:
     def _offset(self, depth: int) -> float:
         return self.config.rotator_offset if depth == 1 else self.config.holder_offset
 
-    def _choose_grip(self, hand: Hand, world_dir: str, depth: int, twist_delta: float = 0.0,
-                     vertical_fingers: bool = True, turn: tuple[str, float] | None = None,
-                     perpendicular: bool = False) -> Pose:
-        """The grip (of four finger placements) the arm reaches, preferring wrist-roll room for the next twist.
+    def _choose_grip(self, hand: Hand, world_dir: str, depth: int, vertical_fingers: bool = True,
+                     turn: tuple[str, float] | None = None, perpendicular: bool = False) -> tuple[Pose, np.ndarray]:
+        """The grip (of four finger placements) the arm reaches with the least joint motion, and its IK solution.
 
-        ``turn`` = (world axis, angle): this hand will give the cube in a hand-over from this grip, so
-        the grip should also let the arm carry that turn without a joint reaching its limit (the PR2's
-        rolls are bounded to +-pi here; IK would flip the arm round mid-turn).
+        The PR2's forearm and wrist rolls are continuous and IK returns them on
+        the branch nearest the current configuration, so any placement leaves
+        room for any twist; placements differ only in how far the arm must
+        move and whether the fingers clear the other hand's.
+        ``turn`` = (world axis, angle): this hand will give the cube in a hand-over from this grip;
+        the grip must also let the arm carry that turn through IK solutions that follow each other
+        (a waypoint whose nearest solution jumps more than ``max_waypoint_jump`` is a change of arm
+        branch — elbow or shoulder — with the cube in hand), and the one with the least joint travel
+        over the turn is preferred.
         ``perpendicular``: the fingers must cross the other hand's (in a shift both hands are two slabs
         deep and overlap along the work axis; in a hand-over the giver's finger lies on the face the
-        taker comes to, and only crossing fingers pass it); otherwise crossing is only preferred.
+        taker comes to, and only crossing fingers pass it); otherwise crossing is preferred.
+        All placements are solved in one batched IK call (and the turn's waypoints in one call each).
         """
         other = self._other(hand)
         other_y = other.last_grip.rotation.apply([0.0, 1.0, 0.0]) if other.holding and other.last_grip else None
@@ -228,59 +254,84 @@ class DeadReckoningStrategy:
         # hand's pads must then also stay off the faces the giver approaches along
         other_on_axis = other_y is not None and abs(float(np.dot(other_y, DIRECTIONS[world_dir]))) > 0.7
         base = hand.arm.base_pose()
-        best, best_score = None, -np.inf
-        fallback, fallback_score = None, -np.inf
         q_now = hand.arm.positions()
-        lo, hi = hand.arm.lower[-1], hand.arm.upper[-1]
+        poses, bonus = [], []
         for pose in grip_candidates(self.est, world_dir, self._offset(depth)):
             fy = pose.rotation.apply([0.0, 1.0, 0.0])
             if not vertical_fingers and abs(fy[2]) > 0.7:
                 continue  # on the table a finger would go under the cube
-            crossing = other_y is None or abs(float(np.dot(fy, other_y))) < 0.3
+            cross = other_y is None or abs(float(np.dot(fy, other_y))) < 0.3
             if other_on_axis:
-                crossing = crossing and abs(float(np.dot(fy, other_x))) < 0.3
-            if perpendicular and not crossing:
+                cross = cross and abs(float(np.dot(fy, other_x))) < 0.3
+            if perpendicular and not cross:
                 continue
-            res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q_now)
-            if not res.success[0]:
-                continue
-            q7 = float(res.q[0][-1])
-            margin = min(q7 - lo, hi - q7, q7 + twist_delta - lo, hi - (q7 + twist_delta))
-            joint_move = float(np.max(np.abs(res.q[0] - q_now)))
-            score = min(margin, 0.3) - 0.1 * joint_move + (0.5 if crossing else 0.0)
-            if margin < 0.0:  # the next twist would run the wrist-roll joint into its limit
-                score -= 10.0
-            if turn is not None:
-                if score > fallback_score:
-                    fallback, fallback_score = pose, score
-                travel = self._turn_travel(hand, base, pose, res.q[0], *turn)
-                if travel is None:
-                    continue
-                score -= 0.1 * travel
-            if score > best_score:
-                best, best_score = pose, score
-        if best is None and fallback is not None:
-            self.ctx.recorder.event("warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly")
-            best = fallback
-        if best is None:
+            parallel = other_y is not None and abs(float(np.dot(fy, other_y))) > 0.7
+            poses.append(pose)
+            if self.finger_preference == "parallel" and not perpendicular:
+                bonus.append(0.5 if parallel else 0.0)
+            else:
+                bonus.append(0.5 if cross else 0.0)
+        if not poses:
+            raise StrategyFailure("unreachable", f"{hand.side} arm: no finger placement from {world_dir} clears the other hand")
+        seeds = [q_now]
+        if turn is not None and self.giver_seeds > 0:
+            # a giver also tries other arm configurations (the 7-DOF arm's self-motion) for each
+            # placement: the turn may only be smooth from another elbow/shoulder posture
+            rng = np.random.default_rng(len(self.ctx.recorder.events))  # deterministic per trial
+            lo = np.where(np.isfinite(hand.arm.lower), hand.arm.lower, -np.inf)
+            hi = np.where(np.isfinite(hand.arm.upper), hand.arm.upper, np.inf)
+            seeds += [np.clip(q_now + rng.normal(0.0, 0.6, q_now.shape), lo, hi) for _ in range(self.giver_seeds)]
+        poses = [p for p in poses for _ in seeds]
+        bonus = [b for b in bonus for _ in seeds]
+        seed_rows = np.stack([q for _ in range(len(poses) // len(seeds)) for q in seeds])
+        res = hand.arm.ik(np.stack([(base.inv() * p).as_matrix() for p in poses]), seed_q=seed_rows)
+        ok = np.asarray(res.success, dtype=bool)
+        if not ok.any():
             raise StrategyFailure("unreachable", f"{hand.side} arm: no grip from {world_dir} reachable")
-        return best
+        score = np.array([-0.1 * float(np.max(np.abs(res.q[i] - q_now))) + bonus[i] for i in range(len(poses))])
+        score[~ok] = -np.inf
+        if turn is not None:
+            travel, worst = self._turn_travel(hand, base, [poses[i] for i in np.flatnonzero(ok)], res.q[ok], *turn)
+            turned = score.copy()
+            turned[np.flatnonzero(ok)] -= 0.1 * travel  # inf travel: the turn cannot be carried from there
+            if np.isfinite(turned).any():
+                score = turned
+            else:  # the least bad: the smallest largest jump on the way
+                score[np.flatnonzero(ok)] -= worst
+                self.ctx.recorder.event("warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly "
+                                        f"(largest joint step {float(np.min(worst)):.2f} rad)")
+        best = int(np.argmax(score))
+        return poses[best], np.array(res.q[best], dtype=float)
 
-    def _turn_travel(self, hand: Hand, base: Pose, grip: Pose, q: np.ndarray, axis: str, angle: float) -> float | None:
-        """Joint travel of carrying the cube from ``grip`` through the hand-over turn; None if a step jumps."""
+    def _turn_travel(self, hand: Hand, base: Pose, grips: list[Pose], q: np.ndarray, axis: str,
+                     angle: float) -> tuple[np.ndarray, np.ndarray]:
+        """Joint travel of carrying the cube from each of ``grips`` through the hand-over turn (inf: not
+        smooth), and the largest joint step on the way (inf: a waypoint out of reach).
+
+        The chain ends with the giver's retreat from the turned grip (``handover_retreat`` back along
+        its approach): a turn that ends at a joint limit leaves no straight way out, and the arm's
+        retreat then swings through the cube on another branch.
+        """
         n = max(1, self.config.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
-        total = 0.0
-        for i in range(1, n + 1):
-            pose = rotate_about_point(grip, self.est.p, axis, angle * i / n)
-            res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q)
-            if not res.success[0]:
-                return None
-            jump = float(np.max(np.abs(res.q[0] - q)))
-            if jump > self.config.max_waypoint_jump:
-                return None
-            total += jump
-            q = res.q[0]
-        return total
+        q = np.array(q, dtype=float)
+        total = np.zeros(len(grips))
+        worst = np.zeros(len(grips))
+        for i in range(1, n + 2):
+            live = np.flatnonzero(np.isfinite(worst))
+            if live.size == 0:
+                break
+            poses = [rotate_about_point(grips[k], self.est.p, axis, angle * min(i, n) / n) for k in live]
+            if i > n:  # the retreat
+                poses = [Pose(p.p - p.rotation.apply([self.handover_retreat, 0.0, 0.0]), p.q) for p in poses]
+            targets = [(base.inv() * p).as_matrix() for p in poses]
+            res = hand.arm.ik(np.stack(targets), seed_q=q[live])
+            jump = np.max(np.abs(res.q - q[live]), axis=1)
+            reached = np.asarray(res.success, dtype=bool)
+            bad = ~reached | (jump > self.config.max_waypoint_jump)
+            total[live] = np.where(bad, np.inf, total[live] + jump)
+            worst[live] = np.where(reached, np.maximum(worst[live], jump), np.inf)
+            q[live] = res.q
+        return total, worst
 
     def _next_turn(self, k: int, side: str) -> tuple[str, float] | None:
         """If ``side``'s next regrasp after action ``k`` is giving the cube in a hand-over: (axis, angle)."""
@@ -291,56 +342,142 @@ class DeadReckoningStrategy:
                 return None
         return None
 
-    def _approach(self, hand: Hand, grip: Pose, label: str) -> None:
-        """Open, go to the pre-grasp stand-off along the approach, move in, close."""
+    def _approach(self, hand: Hand, grip: Pose, label: str, q_plan: np.ndarray | None = None) -> None:
+        """Open, go to the pre-grasp stand-off along the approach, move in, close.
+
+        ``q_plan``: the grip's IK solution the choice was made with (and a
+        hand-over turn checked from); the stand-off, pre-grasp and grip are
+        solved from it, so that the arm arrives on that branch rather than
+        wherever the seeds along the way would lead (measured: a giver that
+        arrived on another branch met a joint limit in the turn's first
+        waypoint and swung the cube 15 degrees).
+        """
         hand.gripper.open(wait=0.3)
         cfg = self.config
         far = Pose(grip.p - grip.rotation.apply([cfg.far_distance, 0, 0]), grip.q)
         if np.linalg.norm(far.p - hand.cmd.p) > 0.01 or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999:
             # swing round to the far stand-off first, so that the swing clears the cube
-            self._send(hand, far, label=f"{label} stand-off", settle=0.05)
+            self._swing(hand, far, label=f"{label} stand-off", seed_q=q_plan)
         back = Pose(grip.p - grip.rotation.apply([cfg.pregrasp_distance, 0, 0]), grip.q)
-        self._send(hand, back, label=f"{label} pre-grasp", settle=0.1)
+        self._send(hand, back, label=f"{label} pre-grasp", settle=0.1, seed_q=q_plan)
         grip = self._relocalise(hand, grip, label)
-        self._send(hand, grip, label=label, settle=0.2)
+        self._send(hand, grip, label=label, settle=0.2, seed_q=q_plan)
+
+    def _swing(self, hand: Hand, far: Pose, label: str, seed_q: np.ndarray | None = None) -> None:
+        """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed centre.
+
+        Why: one joint-space move from where the hand let go (often above or
+        below the cube after a hand-over turn) to a stand-off on another side
+        sweeps the tool frame along whatever path the joints take, and was
+        measured knocking the held cube 12 degrees (SAPIEN, Rubiks-1-20). Here
+        the tool frame moves in Cartesian waypoints (at most 45 degrees apart)
+        on an arc round the cube, its distance from the centre and its
+        orientation interpolated between the two ends, so it never comes
+        nearer the cube than where it started or ends. A waypoint the arm
+        cannot reach is left out.
+        """
+        from scipy.spatial.transform import Slerp
+
+        c = self.est.p
+        d0, d1 = hand.cmd.p - c, far.p - c
+        r0, r1 = float(np.linalg.norm(d0)), float(np.linalg.norm(d1))
+        u0, u1 = d0 / max(r0, 1e-9), d1 / max(r1, 1e-9)
+        angle = math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))
+        n = max(1, math.ceil(angle / (math.pi / 4)))
+        if n == 1 or r0 < 0.05 or r1 < 0.05:
+            self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+            return
+        axis = np.cross(u0, u1)
+        if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
+            axis = np.cross(u0, [0.0, 0.0, 1.0])
+            if np.linalg.norm(axis) < 1e-6:
+                axis = np.array([1.0, 0.0, 0.0])
+        axis = axis / np.linalg.norm(axis)
+        slerp = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([hand.cmd.q, far.q])))
+        base = hand.arm.base_pose()
+        for i in range(1, n):
+            f = i / n
+            u = Rotation.from_rotvec(axis * angle * f).apply(u0)
+            way = Pose.from_rotation(c + ((1 - f) * r0 + f * r1) * u, slerp([f])[0])
+            if hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()).success[0]:
+                self._send(hand, way, label=f"{label} arc", settle=0.02)
+        self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
 
     def _relocalise(self, hand: Hand, grip: Pose, label: str) -> Pose:
         """Hook before a hand moves in to grip (dead reckoning: nothing; sensor-aided: pre-touch)."""
         return grip
 
     def _close(self, hand: Hand, world_dir: str, depth: int, label: str) -> None:
-        g = hand.gripper.close(force_limit=self.config.grip_force, obj=self.cube.body)
+        """Close on the cube; when the other hand holds it, first softly, then with the full grip force.
+
+        Why two stages: a cube held by one parallel gripper pivots about that
+        gripper's pad axis, resisted only by the pads' torsional friction. The
+        closing gripper's first-touching finger pushes the cube with the
+        closing force at a lever of 17-50 mm from that axis; at the full 20 N
+        that out-torques the friction (measured on PyBullet: the cube turned
+        11 degrees at a hand-over take). At ``soft_grip_force`` it does not;
+        once both pads touch, raising the force squeezes symmetrically.
+        """
+        cfg = self.config
+        if self._other(hand).holding and cfg.soft_grip_force > 0:
+            hand.gripper.close(force_limit=cfg.soft_grip_force, obj=self.cube.body)
+        g = hand.gripper.close(force_limit=cfg.grip_force, obj=self.cube.body)
         if g.closed or not g.contact:
             raise StrategyFailure(None, f"{label}: {hand.side} gripper closed on nothing (grasp missed)")
         hand.holding = True
         hand.last_grip = hand.cmd
         hand.cube_in_tcp = hand.cmd.inv() * self.est
         hand.grip_dir, hand.depth = world_dir, depth
+        self._judge(label, hand)
+
+    #: how far the giver backs off along its approach after a hand-over (m)
+    handover_retreat = 0.12
 
     def _release_hand(self, hand: Hand, retreat: float | None = None) -> None:
-        """Open (if holding) and stand off ``retreat`` along the approach from the last grip."""
+        """Open (if holding) and stand off ``retreat`` along the approach from the last grip.
+
+        The open hand is still round the cube, so the retreat must be a
+        straight move: if the stand-off's IK solution is more than
+        ``max_waypoint_jump`` from the arm's joints (a joint limit on the way
+        out, another branch beyond), it backs off in 2 cm steps only as far
+        as the arm follows smoothly and logs a warning.
+        """
         if hand.holding:
             hand.gripper.open(wait=0.3)
         hand.holding, hand.cube_in_tcp, hand.grip_dir, hand.depth = False, None, None, 0
         d = self.config.pregrasp_distance if retreat is None else retreat
         ref = hand.last_grip or hand.cmd
         back = Pose(ref.p - ref.rotation.apply([d, 0, 0]), ref.q)
-        if np.linalg.norm(back.p - hand.cmd.p) > 2e-3 or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3):
+        if not (np.linalg.norm(back.p - hand.cmd.p) > 2e-3
+                or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)):
+            return
+        if self._smooth(hand, back):
             self._send(hand, back, label="retreat", settle=0.05)
+            return
+        step = 0.02
+        dist = float(np.dot(ref.p - hand.cmd.p, ref.rotation.apply([1.0, 0.0, 0.0])))  # already backed off
+        while dist + step <= d + 1e-9:
+            nxt = Pose(ref.p - ref.rotation.apply([dist + step, 0, 0]), ref.q)
+            if not self._smooth(hand, nxt):
+                break
+            self._send(hand, nxt, label="retreat step", settle=0.02)
+            dist += step
+        self.ctx.recorder.event("warning", message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
+                                f"(the straight way out leaves the arm's branch)")
 
-    def _grip(self, hand: Hand, world_dir: str, depth: int, label: str, twist_delta: float = 0.0,
-              vertical_fingers: bool = True, k: int | None = None, perpendicular: bool = False) -> None:
+    def _smooth(self, hand: Hand, target: Pose) -> bool:
+        """Whether the arm reaches ``target`` from its joints without any joint moving > max_waypoint_jump."""
+        base = hand.arm.base_pose()
+        q = hand.arm.positions()
+        res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
+        return bool(res.success[0]) and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
+
+    def _grip(self, hand: Hand, world_dir: str, depth: int, label: str, vertical_fingers: bool = True,
+              k: int | None = None, perpendicular: bool = False) -> None:
         turn = self._next_turn(k, hand.side) if (k is not None and depth == 2) else None
-        grip = self._choose_grip(hand, world_dir, depth, twist_delta, vertical_fingers, turn, perpendicular)
-        self._approach(hand, grip, label)
+        grip, q_plan = self._choose_grip(hand, world_dir, depth, vertical_fingers, turn, perpendicular)
+        self._approach(hand, grip, label, q_plan)
         self._close(hand, world_dir, depth, label)
-
-    def _next_twist_delta(self, k: int, side: str) -> float:
-        """Wrist-roll change of the next twist after action ``k`` if ``side`` makes it (else 0)."""
-        for a in self.plan.actions[k + 1:]:
-            if isinstance(a, Twist):
-                return self._roll_delta(a) if a.gripper == side else 0.0
-        return 0.0
 
     @staticmethod
     def _roll_delta(t: Twist) -> float:
@@ -355,17 +492,19 @@ class DeadReckoningStrategy:
         cfg = self.config
         picker = self.hands[a.gripper]
         other = self._other(picker)
-        depth = 1 if a.rotator == a.gripper else 2
-        self._grip(picker, SIDE_DIR[picker.side], depth, "pick",
-                   self._next_twist_delta(k, picker.side) if depth == 1 else 0.0, vertical_fingers=False)
+        # the picker carries the cube alone: two slabs deep (see _handover), then slides out if it rotates
+        self._grip(picker, SIDE_DIR[picker.side], 2, "pick", vertical_fingers=False)
         lift = np.asarray(cfg.twist_position) - self.est.p
         up = Pose(picker.cmd.p + [0, 0, lift[2] + 0.03], picker.cmd.q)
         self._send(picker, up, label="lift")
         there = Pose(picker.cmd.p + [lift[0], lift[1], -0.03], picker.cmd.q)
         self._send(picker, there, label="carry")
-        odepth = 3 - depth
-        self._grip(other, SIDE_DIR[other.side], odepth, "second grasp",
-                   self._next_twist_delta(k, other.side) if odepth == 1 else 0.0, k=k)
+        if a.rotator == a.gripper:
+            self._grip(other, SIDE_DIR[other.side], 2, "second grasp", k=k, perpendicular=True)
+            self._release_hand(picker)
+            self._grip(picker, SIDE_DIR[picker.side], 1, "pick shift out")
+        else:
+            self._grip(other, SIDE_DIR[other.side], 1, "second grasp", k=k)
 
     def _twist(self, t: Twist, orientation, k: int) -> None:
         cube, rec = self.cube, self.ctx.recorder
@@ -373,7 +512,7 @@ class DeadReckoningStrategy:
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             # after a twist the rotator stands off: a twist right after a twist re-takes its slab
             if hold.holding and hold.depth == 2 and not rot.holding:
-                self._grip(rot, SIDE_DIR[rot.side], 1, "re-grip", self._roll_delta(t))
+                self._grip(rot, SIDE_DIR[rot.side], 1, "re-grip")
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             raise StrategyFailure(None, f"twist {k + 1}: hands not in twisting grips")
         move = twist_move(orientation, t.axis, t.layer, t.quarter_turns)
@@ -388,11 +527,7 @@ class DeadReckoningStrategy:
         cube.begin_twist(body_axis, intended=intended)
         delta = self._roll_delta(t)
         q = rot.arm.positions().copy()
-        want = q[-1] + delta
-        q[-1] = np.clip(want, rot.arm.lower[-1], rot.arm.upper[-1])
-        if abs(q[-1] - want) > 1e-6:
-            rec.event("warning", message=f"twist {k + 1}: wrist roll limited to {math.degrees(q[-1]):.0f}° "
-                      f"({math.degrees(want - q[-1]):.0f}° short)")
+        q[-1] += delta  # the wrist roll is continuous: any twist runs in full
         rot.arm.move_to_joints(q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2)
         rot.cmd = rot.last_grip = turned_about_approach(rot.cmd, delta)
         rot.gripper.open(wait=0.3)
@@ -415,7 +550,7 @@ class DeadReckoningStrategy:
         self._release_hand(new_hold)
         self._grip(new_hold, SIDE_DIR[new_hold.side], 2, "shift in", k=k, perpendicular=True)
         self._release_hand(new_rot)
-        self._grip(new_rot, SIDE_DIR[new_rot.side], 1, "shift out", self._next_twist_delta(k, new_rot.side))
+        self._grip(new_rot, SIDE_DIR[new_rot.side], 1, "shift out")
 
     def _handover(self, a: Handover, k: int) -> None:
         giver, taker = self.hands[a.giver], self.hands[a.taker]
@@ -428,13 +563,21 @@ class DeadReckoningStrategy:
         for i in range(1, n + 1):
             self._send(giver, rotate_about_point(start, centre, a.axis, angle * i / n), label="hand-over turn",
                        settle=0.05 if i < n else 0.2)
-        tdepth = 1 if a.rotator == taker.side else 2
-        self._grip(taker, SIDE_DIR[taker.side], tdepth, "hand-over take",
-                   self._next_twist_delta(k, taker.side) if tdepth == 1 else 0.0, k=k, perpendicular=True)
-        self._release_hand(giver, retreat=0.12)
-        gdepth = 3 - tdepth
-        self._grip(giver, SIDE_DIR[giver.side], gdepth, "hand-over re-grip",
-                   self._next_twist_delta(k, giver.side) if gdepth == 1 else 0.0, k=k)
+        self._judge("hand-over turned", giver)
+        # The taker takes two slabs deep, whichever hand rotates next: it then holds the cube alone
+        # while the giver comes round, and a one-slab grip (12 mm of pad on the face, the weight 34 mm
+        # out) let the cube pivot about its pad axis there (measured on PyBullet: 32 degrees as the
+        # giver let go). If the taker is the next rotator, the giver re-grips two slabs deep as well
+        # (fingers crossing, as in a shift) and the taker then slides out to one slab.
+        self._grip(taker, SIDE_DIR[taker.side], 2, "hand-over take", k=k, perpendicular=True)
+        self._release_hand(giver, retreat=self.handover_retreat)
+        self._judge("hand-over given", taker)
+        if a.rotator == taker.side:
+            self._grip(giver, SIDE_DIR[giver.side], 2, "hand-over re-grip", k=k, perpendicular=True)
+            self._release_hand(taker)
+            self._grip(taker, SIDE_DIR[taker.side], 1, "hand-over shift out")
+        else:
+            self._grip(giver, SIDE_DIR[giver.side], 1, "hand-over re-grip", k=k)
 
     def _release(self) -> None:
         for hand in self.hands.values():
@@ -481,6 +624,46 @@ class SensorAidedStrategy(DeadReckoningStrategy):
                 rng = np.random.default_rng(self.ctx.rng.integers(2**63))
             cache[hand.side] = (sensor, rng)
         return cache[hand.side]
+
+    def _swing(self, hand: Hand, far: Pose, label: str, seed_q: np.ndarray | None = None) -> None:
+        """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed centre.
+
+        Why: one joint-space move from where the hand let go (often above or
+        below the cube after a hand-over turn) to a stand-off on another side
+        sweeps the tool frame along whatever path the joints take, and was
+        measured knocking the held cube 12 degrees (SAPIEN, Rubiks-1-20). Here
+        the tool frame moves in Cartesian waypoints (at most 45 degrees apart)
+        on an arc round the cube, its distance from the centre and its
+        orientation interpolated between the two ends, so it never comes
+        nearer the cube than where it started or ends. A waypoint the arm
+        cannot reach is left out.
+        """
+        from scipy.spatial.transform import Slerp
+
+        c = self.est.p
+        d0, d1 = hand.cmd.p - c, far.p - c
+        r0, r1 = float(np.linalg.norm(d0)), float(np.linalg.norm(d1))
+        u0, u1 = d0 / max(r0, 1e-9), d1 / max(r1, 1e-9)
+        angle = math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))
+        n = max(1, math.ceil(angle / (math.pi / 4)))
+        if n == 1 or r0 < 0.05 or r1 < 0.05:
+            self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+            return
+        axis = np.cross(u0, u1)
+        if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
+            axis = np.cross(u0, [0.0, 0.0, 1.0])
+            if np.linalg.norm(axis) < 1e-6:
+                axis = np.array([1.0, 0.0, 0.0])
+        axis = axis / np.linalg.norm(axis)
+        slerp = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([hand.cmd.q, far.q])))
+        base = hand.arm.base_pose()
+        for i in range(1, n):
+            f = i / n
+            u = Rotation.from_rotvec(axis * angle * f).apply(u0)
+            way = Pose.from_rotation(c + ((1 - f) * r0 + f * r1) * u, slerp([f])[0])
+            if hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()).success[0]:
+                self._send(hand, way, label=f"{label} arc", settle=0.02)
+        self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
 
     def _relocalise(self, hand: Hand, grip: Pose, label: str) -> Pose:
         from ...sensors import CubePoseFilter, PoseEstimate, cube_yaw, yaw_error
