@@ -8,44 +8,11 @@ the strategy's own mistakes from injected ones).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
+
+from ..error_sources import ErrorConfig
 
 __all__ = ["ErrorConfig", "HerbPushGraspConfig"]
-
-
-@dataclass(frozen=True)
-class ErrorConfig:
-    """Injected errors, each drawn from the strategy's ``ctx.rng`` (same model as the PR2 baselines').
-
-    * **Arm calibration offset** (per arm, fixed for the trial): the arm
-      reaches ``offset * commanded``; a WAM's calibration to the head camera
-      is good to a few mm.
-    * **Actuator tracking noise** (per motion): each commanded tool pose is
-      perturbed by an independent Gaussian translation the strategy never sees.
-    * **Camera noise**: the head camera's one-shot estimate of the cube on the
-      table (``benchharness.sensors.HeadCamera`` defaults when importable,
-      else the fallback figures below). After that the belief only changes by
-      dead reckoning and by push-grasp contacts.
-    """
-
-    #: std of each arm's fixed calibration offset, per world axis (m).
-    calib_pos_std: float = 0.0015
-    #: std of each arm's fixed calibration rotation, per world axis (deg).
-    calib_rot_std_deg: float = 0.5
-    #: std of the per-motion tracking error of a commanded tool pose, per world axis (m).
-    tracking_std: float = 0.001
-    #: fallback camera noise when benchharness.sensors is absent: position std (m), yaw std (deg)
-    camera_pos_std: float = 0.003
-    camera_yaw_std_deg: float = 2.0
-    #: use the head camera at all (False = the initial estimate is the true pose)
-    camera: bool = True
-
-    def zero(self) -> "ErrorConfig":
-        return ErrorConfig(**{f.name: (False if f.name == "camera" else 0.0) for f in fields(self)})
-
-    @property
-    def is_zero(self) -> bool:
-        return not self.camera and all(getattr(self, f.name) == 0.0 for f in fields(self) if f.name != "camera")
 
 
 @dataclass(frozen=True)

@@ -8,46 +8,11 @@ the strategy's own mistakes from injected ones).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
+
+from ..error_sources import ErrorConfig
 
 __all__ = ["ErrorConfig", "PR2RubiksConfig"]
-
-
-@dataclass(frozen=True)
-class ErrorConfig:
-    """Injected errors, each drawn from the strategy's ``ctx.rng``.
-
-    * **Arm calibration offset** (per arm, fixed for the trial): the arm
-      reaches ``offset * commanded`` instead of ``commanded``; a real PR2's
-      arm-to-head kinematic calibration is good to a few mm.
-    * **Actuator tracking noise** (per motion): each commanded tool pose is
-      perturbed by an independent Gaussian translation. Dead reckoning never
-      sees it, so it accumulates as a random walk over regrasps.
-    * **Camera noise**: the head camera's one-shot estimate of the cube on the
-      table; ``benchharness.sensors.HeadCameraConfig`` defaults when that
-      package is importable (4 mm xy, 2 mm z, 3° yaw, 1° tilt), else the
-      figures below.
-    """
-
-    #: std of each arm's fixed calibration offset, per world axis (m). 1.5 mm: a few-mm calibrated PR2.
-    calib_pos_std: float = 0.0015
-    #: std of each arm's fixed calibration rotation, per world axis (deg).
-    calib_rot_std_deg: float = 0.5
-    #: std of the per-motion tracking error of a commanded tool pose, per world axis (m).
-    #: 1 mm: a PR2 arm's repeatability under its PD control is of that order.
-    tracking_std: float = 0.001
-    #: fallback camera noise when benchharness.sensors is absent: position std (m), yaw std (deg)
-    camera_pos_std: float = 0.003
-    camera_yaw_std_deg: float = 2.0
-    #: use the head camera at all (False = the initial estimate is the true pose)
-    camera: bool = True
-
-    def zero(self) -> "ErrorConfig":
-        return ErrorConfig(**{f.name: (False if f.name == "camera" else 0.0) for f in fields(self)})
-
-    @property
-    def is_zero(self) -> bool:
-        return not self.camera and all(getattr(self, f.name) == 0.0 for f in fields(self) if f.name != "camera")
 
 
 @dataclass(frozen=True)

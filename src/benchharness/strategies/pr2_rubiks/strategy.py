@@ -625,46 +625,6 @@ class SensorAidedStrategy(DeadReckoningStrategy):
             cache[hand.side] = (sensor, rng)
         return cache[hand.side]
 
-    def _swing(self, hand: Hand, far: Pose, label: str, seed_q: np.ndarray | None = None) -> None:
-        """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed centre.
-
-        Why: one joint-space move from where the hand let go (often above or
-        below the cube after a hand-over turn) to a stand-off on another side
-        sweeps the tool frame along whatever path the joints take, and was
-        measured knocking the held cube 12 degrees (SAPIEN, Rubiks-1-20). Here
-        the tool frame moves in Cartesian waypoints (at most 45 degrees apart)
-        on an arc round the cube, its distance from the centre and its
-        orientation interpolated between the two ends, so it never comes
-        nearer the cube than where it started or ends. A waypoint the arm
-        cannot reach is left out.
-        """
-        from scipy.spatial.transform import Slerp
-
-        c = self.est.p
-        d0, d1 = hand.cmd.p - c, far.p - c
-        r0, r1 = float(np.linalg.norm(d0)), float(np.linalg.norm(d1))
-        u0, u1 = d0 / max(r0, 1e-9), d1 / max(r1, 1e-9)
-        angle = math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))
-        n = max(1, math.ceil(angle / (math.pi / 4)))
-        if n == 1 or r0 < 0.05 or r1 < 0.05:
-            self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
-            return
-        axis = np.cross(u0, u1)
-        if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
-            axis = np.cross(u0, [0.0, 0.0, 1.0])
-            if np.linalg.norm(axis) < 1e-6:
-                axis = np.array([1.0, 0.0, 0.0])
-        axis = axis / np.linalg.norm(axis)
-        slerp = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([hand.cmd.q, far.q])))
-        base = hand.arm.base_pose()
-        for i in range(1, n):
-            f = i / n
-            u = Rotation.from_rotvec(axis * angle * f).apply(u0)
-            way = Pose.from_rotation(c + ((1 - f) * r0 + f * r1) * u, slerp([f])[0])
-            if hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()).success[0]:
-                self._send(hand, way, label=f"{label} arc", settle=0.02)
-        self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
-
     def _relocalise(self, hand: Hand, grip: Pose, label: str) -> Pose:
         from ...sensors import CubePoseFilter, PoseEstimate, cube_yaw, yaw_error
 
