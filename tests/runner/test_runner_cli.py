@@ -181,3 +181,27 @@ def test_inhand_figure7_plot_and_compare_summary(invoke, tmp_path):
 def test_table_plot_without_inhand_trials_is_a_clear_error(invoke, tmp_path):
     r = invoke(table, "--plot", str(tmp_path / "f.png"))
     assert r.exit_code == 2 and "no in-hand trials" in r.output
+
+
+def test_table3_contact_rows_come_from_the_scorer_and_only_for_successes(invoke, store_path):
+    from benchharness.runner.reports import inhand_table3
+    from benchharness.runner.store import ResultsStore
+
+    invoke(run, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "3", *BASE)
+    with ResultsStore(store_path) as store:
+        trials = store.trials(benchmark="inhand")
+    seen = []
+
+    def scorer(t):  # G values that identify the trial: repeat k -> k cm
+        seen.append(t.status.value)
+        return {"g_euc": 0.01 * t.outcome["repeat"], "g_geo": 0.02, "g_min": 0.001}
+
+    rows = inhand_table3(trials, contact_scorer=scorer)
+    assert set(seen) == {"success"}
+    for r in rows:
+        ok = [t.outcome["repeat"] for t in trials if t.outcome["task_id"] == r["task_id"] and t.status.value == "success"]
+        want = float(np.median(ok)) if ok else None
+        assert r["ours"]["g_euc_cm"] == (pytest.approx(want) if ok else None)
+        assert r["ours"]["g_geo_cm"] == (pytest.approx(2.0) if ok else None)
+        assert r["paper"]["graph_time_s"] > 10  # the paper's DMG time, Table III
+    assert all(r["ours"]["g_euc_cm"] is None for r in inhand_table3(trials))

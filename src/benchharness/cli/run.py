@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import click
+import numpy as np
 
 from .common import EXIT_NEGATIVE, emit_json, fail, json_option
 
@@ -369,7 +370,7 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
             if not tab.columns:
                 console.print("No Rubik's results in the store yet (benchharness run --task Rubiks-...).")
     if "inhand" in wanted:
-        t2, t3 = inhand_table2(trials), inhand_table3(trials)
+        t2, t3 = inhand_table2(trials), inhand_table3(trials, contact_scorer=_contact_scorer())
         if as_json:
             out["inhand"] = {"table2": t2, "table3": t3}
         else:
@@ -396,8 +397,6 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
                 for r in rows:
                     t.add_column(_esc(f"{r['object']} [{r['task_id']}]"), justify="right")
                 for key, label in TABLE_III_ROWS.items():
-                    if key.startswith("g_"):
-                        continue  # contact metrics need meshes the runner does not have yet
                     cells = []
                     for r in rows:
                         paper = r["paper"].get(key)
@@ -417,6 +416,40 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
             console.print(f"Box plot (Figure 7 layout) written to {plot_path}")
     if as_json:
         emit_json(out)
+
+
+def _contact_scorer():
+    """G_euc / G_geo / G_min of a stored trial with reached contacts, on our mesh in the task frame.
+
+    The mesh placement in the published task frame is the DMG package's
+    (``strategies.dmg.regions``); desired contacts come from the task-set
+    plugin named by the trial's run. Trials without contacts score None.
+    """
+    try:
+        from ..strategies.dmg.regions import contact_errors
+    except ImportError:  # trimesh/potpourri3d absent: the table prints without G
+        return None
+    from ..plugin import get_manager
+
+    desired: dict[str, dict[str, Any]] = {}
+
+    def score(trial) -> dict[str, float] | None:
+        o = trial.outcome
+        rc = o.get("reached_contacts")
+        if not rc:
+            return None
+        if trial.task not in desired:
+            try:
+                ts = get_manager().create("task", trial.task)
+                desired[trial.task] = {str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)}
+            except Exception:  # not an in-hand task set with contacts
+                desired[trial.task] = {}
+        want = desired[trial.task].get(o.get("task_id"))
+        if want is None or not np.all(np.isfinite(np.asarray(want, float))):
+            return None
+        return contact_errors(o["object"], want, rc)
+
+    return score
 
 
 # -- compare -----------------------------------------------------------------------------------
