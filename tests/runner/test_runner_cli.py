@@ -205,3 +205,18 @@ def test_table3_contact_rows_come_from_the_scorer_and_only_for_successes(invoke,
         assert r["ours"]["g_geo_cm"] == (pytest.approx(2.0) if ok else None)
         assert r["paper"]["graph_time_s"] > 10  # the paper's DMG time, Table III
     assert all(r["ours"]["g_euc_cm"] is None for r in inhand_table3(trials))
+
+
+def test_one_method_is_one_column_across_tiers_with_their_own_default_budgets(invoke):
+    # the default simulated-time budget grows with a tier's moves, so each tier has its own options hash
+    for tier in ("Rubiks-1-5", "Rubiks-1-10"):
+        assert invoke(run, "--task", tier, "--strategy", "test-timed", *BASE).exit_code == 0
+    data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
+    labels = {lab for row in data["rows"] for lab in row["ours"]}
+    assert labels == {"test-timed (test-stub, pybullet)"}
+    # the same tier run again with other options is a different run: then the method splits by options
+    # hash (one column per distinct hash: the store cannot tell a default budget from a chosen one)
+    assert invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE, "--sim-budget", "500").exit_code == 0
+    data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
+    labels = {lab for row in data["rows"] for lab in row["ours"]}
+    assert len(labels) == 3 and all(lab.startswith("test-timed (test-stub, pybullet) options ") for lab in labels)

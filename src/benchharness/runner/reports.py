@@ -66,11 +66,27 @@ class Column:
 
 
 def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Column]]:
-    """Columns in first-seen order, labelled as briefly as still tells them apart."""
+    """Columns in first-seen order, labelled as briefly as still tells them apart.
+
+    Run options (budgets, repeats) split a method into two columns only where
+    the same task was run with different options: the default simulated-time
+    budget grows with a tier's moves, so every tier of one method has its own
+    options hash and must still land in one column.
+    """
+    trials = list(trials)
+
+    def method_key(t: StoredTrial) -> tuple:
+        return (t.robot, t.strategy, t.sensors, t.backend, t.seed, t.physics_hash, t.code_version)
+
+    options: dict[tuple, set[str]] = {}
+    for t in trials:
+        options.setdefault((method_key(t), t.task), set()).add(t.options_hash)
+    split = {mk for (mk, _), hashes in options.items() if len(hashes) > 1}
     raw: dict[tuple, StoredTrial] = {}
     by_run: dict[str, tuple] = {}
     for t in trials:
-        k = (t.robot, t.strategy, t.sensors, t.backend, t.seed, t.physics_hash, t.options_hash, t.code_version)
+        mk = method_key(t)
+        k = (*mk[:6], t.options_hash if mk in split else "", mk[6])
         raw.setdefault(k, t)
         by_run[t.run_key] = k
     base: dict[tuple, str] = {k: t.method for k, t in raw.items()}
@@ -79,6 +95,8 @@ def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Col
         same = [o for o, lab in base.items() if lab == base[k] and o != k]
         extra = []
         for f in _DISTINGUISH:
+            if f == "options_hash" and not k[6]:
+                continue
             if any(getattr(raw[o], f) != getattr(t, f) for o in same):
                 extra.append(f"seed {t.seed}" if f == "seed" else f"{f.split('_')[0]} {getattr(t, f)}")
         labels[k] = base[k] + (" " + ", ".join(extra) if extra else "")
