@@ -26,7 +26,9 @@ def pose_error_series(trials: Sequence[StoredTrial]) -> dict[str, dict[str, np.n
     acc: dict[str, list[tuple[int, float, float]]] = defaultdict(list)
     for t in trials:
         for e in t.diagnostics.get("pose_estimates") or []:
-            if e.get("pos_err_m") is None:
+            # an estimate logged after the release (older stores) compares a cube lying on the
+            # table with a belief nobody holds: not an estimation error
+            if e.get("pos_err_m") is None or e.get("label") == "release":
                 continue
             acc[col_of[t.run_key].label].append((int(e["move_index"]), 1000.0 * float(e["pos_err_m"]),
                                                  float(e.get("rot_err_deg") or np.nan)))

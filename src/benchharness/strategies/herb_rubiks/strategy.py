@@ -158,7 +158,8 @@ class PushGraspStrategy:
                     self._release()
                 if not isinstance(action, Release):
                     self._check_drop(k)
-                rec.pose_estimate(move_index, self.cube.pose(), self.est, label=type(action).__name__.lower())
+                    # after the release nothing believes where the cube lies (see pr2_rubiks)
+                    rec.pose_estimate(move_index, self.cube.pose(), self.est, label=type(action).__name__.lower())
         except StrategyFailure as e:
             rec.event("failure", cause=e.cause, message=str(e))
             if e.cause is None:
