@@ -72,3 +72,21 @@ def drive_command(
         q = as_array(positions, n, "positions")
     v = np.zeros(n) if velocities is None else as_array(velocities, n, "velocities")
     return DriveCommand(q, v, k, d, f)
+
+
+def joint_indices(b, joints: Sequence[str] | None) -> list[int]:
+    """Indices into ``b.joints`` of the named movable joints (all when ``joints`` is None).
+
+    ``b`` is a backend's body record with ``name``, ``joints`` (JointInfo list)
+    and ``jmap`` (a name -> index cache, built on first use). Both backends
+    resolve names this way, so a wrong name gets the same error on each.
+    """
+    if joints is None:
+        return list(range(len(b.joints)))
+    if len(b.jmap) != len(b.joints):  # name -> index, built once per body
+        b.jmap = {j.name: i for i, j in enumerate(b.joints)}
+    try:
+        return [b.jmap[n] for n in joints]
+    except KeyError as exc:
+        names = [j.name for j in b.joints]
+        raise BackendError(f"body {b.name!r} has no movable joint {exc.args[0]!r}; joints: {names}") from None

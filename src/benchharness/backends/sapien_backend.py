@@ -30,7 +30,7 @@ import numpy as np
 
 from ..geometry import Pose
 from . import SAPIEN_CAPABILITIES
-from ._drives import as_array, drive_command
+from ._drives import as_array, drive_command, joint_indices
 from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, collision_only_copy, mass_properties, parse_urdf
 from .interface import (
     Backend,
@@ -193,15 +193,7 @@ class SapienBackend(Backend):
             raise BackendError(f"body {b.name!r} has no link {link!r}; links: {list(b.links)}") from None
 
     def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
-        if joints is None:
-            return list(range(len(b.joints)))
-        if len(b.jmap) != len(b.joints):  # name -> index, built once per body
-            b.jmap = {j.name: i for i, j in enumerate(b.joints)}
-        try:
-            return [b.jmap[n] for n in joints]
-        except KeyError as exc:
-            names = [j.name for j in b.joints]
-            raise BackendError(f"body {b.name!r} has no movable joint {exc.args[0]!r}; joints: {names}") from None
+        return joint_indices(b, joints)
 
     def _register(self, b: _Body) -> int:
         self._bodies[b.handle] = b
