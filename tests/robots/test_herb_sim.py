@@ -32,16 +32,7 @@ def test_arm_tracks_trajectory_to_pose(make_backend, make_robot, backend):
     check_motion(arm.move_to_pose(goal, seed=2))
 
 
-@pytest.mark.parametrize(
-    "backend",
-    [
-        pytest.param("pybullet", marks=pytest.mark.xfail(
-            reason="PyBullet: the three-finger pinch holds for 3 of 5 cube offsets of 2-3 mm (SAPIEN: 5 of 5); "
-            "the light BarrettHand finger links exceed their joint limits under contact on PyBullet "
-            "(-0.17 rad at 1 N m), reported to the backends owner", strict=False)),
-        "sapien",
-    ],
-)
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
 def test_hand_grasps_and_lifts_cube(make_backend, make_robot, backend):
     be = make_backend(backend)
     be.add_ground()

@@ -90,6 +90,14 @@ class PhysicsConfig:
     solver_velocity_iterations: int = 1
     contact_offset: float = 0.002  #: SAPIEN/PhysX contact offset (m); 1 cm default is too large here
     default_friction: float = 1.0
+    #: PyBullet only: torsional friction arm (m) of every contact, as Bullet's ``spinningFriction``
+    #: (a pair gets this times the pair's friction coefficient). Bullet's point contacts have next to no
+    #: torsional friction once sliding, so a pinched cube turns about the pinch axis like a hinge; a real
+    #: pad's pressure patch resists with mu N r_mean (r_mean = 11 mm for the PR2's 35 x 22 mm pad, 7.7 mm
+    #: for a 20 mm square). Measured, 20 mm pads, 2 x 20 N, friction 1 (analytic 0.31 N m): PyBullet 0.001
+    #: N m without this, 0.40 N m with 0.01 m; PhysX 0.57 N m (its patch friction acts at the patch corners
+    #: and needs no correction). See docs/backends.md. 0 = Bullet's own behaviour.
+    torsional_friction: float = 0.01
     seed: int = 0  #: seeds any randomness a backend itself uses
 
 

@@ -337,6 +337,14 @@ class PyBulletBackend(Backend):
             velocityGains=b.ones, physicsClientId=self._cid,
         )
 
+    def _spinning(self, friction: float) -> float:
+        """A body's ``spinningFriction`` for :attr:`PhysicsConfig.torsional_friction`.
+
+        Bullet combines a pair as ``s_a mu_b + s_b mu_a``; half the arm times the body's own
+        friction makes that ``arm * mu_a * mu_b``, i.e. the arm times the pair's friction.
+        """
+        return 0.5 * float(self.config.torsional_friction) * float(friction)
+
     # -- bodies ----------------------------------------------------------------
     def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
         cid = self._cid
@@ -347,7 +355,7 @@ class PyBulletBackend(Backend):
         )
         uid = pb.createMultiBody(0.0, shape, vis, basePosition=[0, 0, height], physicsClientId=cid)
         fr = self.config.default_friction if friction is None else friction
-        pb.changeDynamics(uid, -1, lateralFriction=fr, physicsClientId=cid)
+        pb.changeDynamics(uid, -1, lateralFriction=fr, spinningFriction=self._spinning(fr), physicsClientId=cid)
         h = self._register(_Body(uid, "ground", None, {}, [], [], Pose(), True))
         self._grounds[h] = float(height)
         return h
@@ -402,7 +410,8 @@ class PyBulletBackend(Backend):
             uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
         )
         fr = self.config.default_friction if friction is None else friction
-        kw = {"lateralFriction": fr, "linearDamping": 0.0, "angularDamping": 0.0, "frictionAnchor": 1}
+        kw = {"lateralFriction": fr, "spinningFriction": self._spinning(fr), "linearDamping": 0.0,
+              "angularDamping": 0.0, "frictionAnchor": 1}
         if not fixed:
             kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
         pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
@@ -506,7 +515,9 @@ class PyBulletBackend(Backend):
         for i in range(-1, pb.getNumJoints(uid, physicsClientId=cid)):
             pb.changeDynamics(
                 uid, i, linearDamping=0.0, angularDamping=0.0, jointDamping=0.0,
-                lateralFriction=float(self.config.default_friction), frictionAnchor=1, physicsClientId=cid,
+                lateralFriction=float(self.config.default_friction),
+                spinningFriction=self._spinning(float(self.config.default_friction)), frictionAnchor=1,
+                physicsClientId=cid,
             )
         # filter pairs adjacent through fixed links (PhysX does not, we do on both engines)
         def idx(l: str) -> int:
