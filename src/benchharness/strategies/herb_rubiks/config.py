@@ -66,12 +66,39 @@ class HerbPushGraspConfig:
     #: in a hand-over the taker pinches the same pair of faces as the giver (True) rather than crossing
     #: it (the PR2's rule): crossing puts the taker's outer finger through the giver's curled thumb.
     taker_parallel: bool = True
+    #: a grip on the faces the other holding hand pinches (a parallel hand-over take) keeps its fingers this
+    #: far from that hand's finger links (m), sliding across its face (tool y) until they do: with both hands
+    #: on the same two faces the taker's closing fingers stalled on the giver's (2nd hand-over of Rubiks-1-5).
+    handover_clearance: float = 0.003
+    #: how far beyond the tool frame a closed outer finger reaches along the approach (m): the distal
+    #: box's tip, measured 48-49 mm on a 57 mm cube (SAPIEN, both depths).
+    finger_reach: float = 0.049
+    #: half width of an outer finger across the palm (m): the proximal link box is 24 mm wide.
+    finger_half_width: float = 0.012
+    #: such a grip may slide across its face at most this far (m) from the face centre: the finger then
+    #: still covers 20 of its 24 mm on the face.
+    max_lateral: float = 0.02
+    #: a rotator whose grip slid farther than this (m) off its face centre lets go and grips again before
+    #: the twist: the wrist rolls about the palm axis, and off the layer's axis the layer is dragged round.
+    max_twist_slide: float = 0.005
+    #: the thumb's tip must touch the face at least this far inside its edge (m): half the distal link's
+    #: 14 mm thickness and margin, so the push stops on the face, not on its edge.
+    thumb_edge_margin: float = 0.007
     #: joint torque cap of the outer fingers when closing (N m).
     grip_torque: float = 2.0
     #: closing speed of the outer fingers' command (rad/s).
     finger_speed: float = 1.5
     #: stand-off the arm swings round at before a push (m), along the approach from the believed contact.
     far_distance: float = 0.15
+    #: a free hand swings round the cube to its stand-off while the other holds it alone on an arc about
+    #: the cube, in joint-space moves of at most this many degrees: one joint-space move from beside the cube
+    #: to behind it swept the re-gripping hand through the taker's thumb and the cube fell (measured, SAPIEN).
+    swing_step_deg: float = 20.0
+    #: only a hand whose tool frame is nearer the cube than this (m) swings round it; one farther away
+    #: (e.g. an arm far out at its side) moves straight to its stand-off as before.
+    swing_radius: float = 0.30
+    #: largest joint change (rad) between two swing waypoints (bigger = IK flipped the arm, which would sweep).
+    swing_max_joint_step: float = 1.5
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
     #: duration of one quarter turn of the wrist (WAM joint 7) (s).

@@ -22,8 +22,9 @@ from scipy.spatial.transform import Rotation
 from ...geometry import Pose
 from ..pr2_rubiks.frames import DIRECTIONS, grip_candidates, rotate_about_point
 
-__all__ = ["CUBE_HALF", "DIRECTIONS", "HERB_FROM_PR2", "approach_axis", "pinch_axis", "push_grip_candidates",
-           "reanchor_along_approach", "rotate_about_point", "rolled_about_approach", "thumb_face_depth"]
+__all__ = ["CUBE_HALF", "DIRECTIONS", "HERB_FROM_PR2", "PROX_CORNERS", "DIST_CORNERS", "approach_axis", "band_clear",
+           "finger_extent", "pinch_axis", "push_grip_candidates", "reanchor_along_approach", "rotate_about_point",
+           "rolled_about_approach", "thumb_face_depth", "thumb_tip_lateral"]
 
 CUBE_HALF = 0.0285
 #: rotation PR2 tool frame -> HERB tool frame (columns: HERB axes in PR2 tool coordinates)
@@ -33,6 +34,11 @@ HERB_FROM_PR2 = Rotation.from_matrix(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0],
 _DIST_LEN = 0.055
 _DIST_CORNERS = np.array([[sx * 0.011, sy * 0.007, 0.003 + sz] for sx in (-1, 1) for sy in (-1, 1)
                           for sz in (0.0, _DIST_LEN - 0.006)])
+#: the same, public (distal links of any finger)
+DIST_CORNERS = _DIST_CORNERS
+#: BarrettHand proximal link box (24 x 16 mm, 58 mm long, centred 37 mm past the flex joint), link frame
+PROX_CORNERS = np.array([[sx * 0.012, sy * 0.008, 0.037 + sz * 0.029] for sx in (-1, 1) for sy in (-1, 1)
+                         for sz in (-1, 1)])
 
 
 def approach_axis(tool: Pose) -> np.ndarray:
@@ -65,6 +71,54 @@ def thumb_face_depth(tool: Pose, distal: Pose) -> float:
     corners = distal.rotation.apply(_DIST_CORNERS) + distal.p
     local = tool.rotation.inv().apply(corners - tool.p)
     return float(np.max(local[:, 2]))
+
+
+def thumb_tip_lateral(tool: Pose, distal: Pose) -> float:
+    """Where across the palm (tool y, m) the thumb's tip touches a face perpendicular to the approach.
+
+    The corners of the distal link within 2 mm of the farthest along the
+    approach are the ones that touch; their mean tool-y coordinate is the
+    tip's lateral position (negative: the tip curls past the palm axis, away
+    from the thumb's root).
+    """
+    corners = distal.rotation.apply(_DIST_CORNERS) + distal.p
+    local = tool.rotation.inv().apply(corners - tool.p)
+    top = local[:, 2] > np.max(local[:, 2]) - 0.002
+    return float(np.mean(local[top, 1]))
+
+
+def finger_extent(tool_cmd: Pose, tool_measured: Pose, link_poses: list[tuple[Pose, np.ndarray]], frame: Pose
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Extent (min, max) in ``frame``'s coordinates of finger link boxes of a hand believed at ``tool_cmd``.
+
+    ``link_poses`` are (measured link pose, box corners in the link frame)
+    of the hand's own links, and ``tool_measured`` its measured tool pose: the
+    boxes are placed relative to the *believed* tool pose (what the strategy
+    knows of where the hand is relative to the cube), from the robot's own
+    kinematics.
+    """
+    pts = []
+    rel = tool_cmd * tool_measured.inv()
+    for link, corners in link_poses:
+        w = rel * link
+        pts.append(w.rotation.apply(corners) + w.p)
+    loc = frame.rotation.inv().apply(np.vstack(pts) - frame.p)
+    return loc.min(axis=0), loc.max(axis=0)
+
+
+def band_clear(lo: np.ndarray, hi: np.ndarray, lateral: float, half_width: float, reach: float,
+               clearance: float) -> bool:
+    """Whether a hand's closing outer fingers stay clear of an obstacle box (``lo``, ``hi``) in its tool frame.
+
+    The closing fingers sweep, across the palm (tool y), ``lateral`` +-
+    ``half_width`` and along the approach (tool z) everything up to ``reach``
+    beyond the tool frame; both spans padded by ``clearance``. The pinch
+    axis (tool x) is not checked: the fingers of both hands lie on the same
+    two faces when the hand pinches the faces the other hand pinches.
+    """
+    y_clear = lateral + half_width + clearance <= lo[1] or lateral - half_width - clearance >= hi[1]
+    z_clear = lo[2] >= reach + clearance
+    return bool(y_clear or z_clear)
 
 
 def reanchor_along_approach(belief: Pose, tool_at_contact: Pose, face_depth: float) -> tuple[Pose, float]:

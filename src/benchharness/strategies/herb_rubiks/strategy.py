@@ -33,8 +33,9 @@ from ...geometry import Pose
 from ...runner.contract import TrialContext, TrialOutcome
 from ..regrasp import HandModel, Handover, Pick, Regrasp, Release, Twist, execute, plan_sequence, twist_move
 from .config import HerbPushGraspConfig
-from .frames import (CUBE_HALF, DIRECTIONS, approach_axis, pinch_axis, push_grip_candidates, reanchor_along_approach,
-                     rolled_about_approach, rotate_about_point, thumb_face_depth)
+from .frames import (CUBE_HALF, DIST_CORNERS, DIRECTIONS, PROX_CORNERS, approach_axis, band_clear, finger_extent,
+                     pinch_axis, push_grip_candidates, reanchor_along_approach, rolled_about_approach,
+                     rotate_about_point, thumb_face_depth, thumb_tip_lateral)
 from .push import (OUTER_FINGER_JOINTS, PushUnreachable, _force_limits, close_outer_fingers, preshape,
                    push_until_contact, wait_fingers)
 
@@ -42,6 +43,21 @@ __all__ = ["PushGraspStrategy", "StrategyFailure"]
 
 SIDE_DIR = {"left": "+y", "right": "-y"}
 BODY_AXIS_OF_FACE = {"U": "z", "D": "z", "R": "x", "L": "x", "F": "y", "B": "y"}
+
+
+def _axis_name(v) -> str:
+    """The world axis nearest ``v`` ('+x', '-z', ...), for diagnostics."""
+    i = int(np.argmax(np.abs(v)))
+    return ("+" if v[i] > 0 else "-") + "xyz"[i]
+
+
+def _turn_between(a: np.ndarray, b: np.ndarray) -> Rotation:
+    """The shortest rotation taking unit vector ``a`` to unit vector ``b`` (about a horizontal axis if opposite)."""
+    axis = np.cross(a, b)
+    ang = math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0)))
+    if np.linalg.norm(axis) < 1e-9:
+        axis = np.cross(a, [0.0, 0.0, 1.0]) if abs(a[2]) < 0.9 else np.cross(a, [1.0, 0.0, 0.0])
+    return Rotation.from_rotvec(axis / np.linalg.norm(axis) * ang)
 
 
 class StrategyFailure(Exception):
@@ -68,6 +84,8 @@ class Hand:
     depth: int = 0
     shape: int = 0  #: depth of the current pre-shape (0: none yet)
     face_depth: float = 0.0  #: thumb tip beyond the tool frame in the current pre-shape (m), measured
+    slide: float = 0.0  #: how far the current grip slid across its face off the nominal, to clear the other hand (m)
+    thumb_lateral: float = 0.0  #: where across the palm (tool y, m) the thumb's tip touches, measured
     log: list = field(default_factory=list)
 
 
@@ -236,6 +254,7 @@ class PushGraspStrategy:
         prefix = hand.arm.config.tcp_link.split("_")[0]
         distal = self.b.get_link_pose(self.robot.body, f"{prefix}_bh_finger_33_link")
         hand.face_depth = thumb_face_depth(hand.arm.tcp_pose(), distal)
+        hand.thumb_lateral = thumb_tip_lateral(hand.arm.tcp_pose(), distal)
         hand.shape = depth
 
     def _choose_grip(self, hand: Hand, world_dir: str, twist_delta: float = 0.0, horizontal_pinch: bool = False,
@@ -258,10 +277,21 @@ class PushGraspStrategy:
         q_now = hand.arm.positions()
         lo, hi = hand.arm.lower[-1], hand.arm.upper[-1]
         best, best_score, fallback, fallback_score = None, -np.inf, None, -np.inf
+        best_slide = fallback_slide = 0.0
+        tried: list[str] = []  # diagnostic for the recorder: each candidate and why it was taken or not
         lateral = self.config.rotator_thumb_offset if hand.shape == 1 else self.config.holder_thumb_offset
         for pose in push_grip_candidates(self.est, world_dir, hand.face_depth):
-            pose = Pose(pose.p + pose.rotation.apply([0.0, lateral, 0.0]), pose.q)
             fx = pinch_axis(pose)
+            tag = f"pinch {_axis_name(fx)} thumb {_axis_name(pose.rotation.apply([0.0, 1.0, 0.0]))}"
+            shift = lateral
+            if other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7:  # both hands on the same faces
+                shift = self._clear_lateral(hand, pose, lateral)
+                if shift is None:
+                    tried.append(f"{tag}: fingers cannot clear the other hand's")
+                    continue
+                if abs(shift - lateral) > 1e-4:
+                    tag += f" slid {1000 * (shift - lateral):+.0f} mm"
+            pose = Pose(pose.p + pose.rotation.apply([0.0, shift, 0.0]), pose.q)
             if horizontal_pinch and (abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7):
                 continue  # on the table: no outer finger under the cube, and the thumb's root below (its tip
                 # curls up onto the face, clear of the table top)
@@ -269,11 +299,14 @@ class PushGraspStrategy:
             if other_on_axis:
                 crossing = crossing and abs(float(np.dot(fx, other_z))) < 0.3
             if perpendicular and not crossing:
+                tried.append(f"{tag}: not crossing")
                 continue
             if parallel and (other_x is None or abs(float(np.dot(fx, other_x))) < 0.7):
+                tried.append(f"{tag}: not parallel")
                 continue
             res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q_now)
             if not res.success[0]:
+                tried.append(f"{tag}: no IK")
                 continue
             q7 = float(res.q[0][-1])
             margin = min(q7 - lo, hi - q7, q7 + twist_delta - lo, hi - (q7 + twist_delta))
@@ -286,6 +319,7 @@ class PushGraspStrategy:
                 # on the face the taker's thumb comes to, and the taker's push would meet the finger
                 turned = Rotation.from_rotvec(DIRECTIONS[turn[0]] * turn[1])
                 if abs(float(turned.apply(fx)[1])) > 0.7:
+                    tried.append(f"{tag}: pinch on the work axis after the turn")
                     continue
                 # and its thumb, curled over the face it pushed, should rise towards its root on the side
                 # away from the taker (a preference: with the root on the taker's side, the giver's fingers,
@@ -294,19 +328,51 @@ class PushGraspStrategy:
                 if float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir)) > -0.7:
                     score -= 1.0
                 if score > fallback_score:
-                    fallback, fallback_score = pose, score
+                    fallback, fallback_score, fallback_slide = pose, score, shift - lateral
                 travel = self._turn_travel(hand, base, pose, res.q[0], *turn)
                 if travel is None:
+                    tried.append(f"{tag}: turn not smooth (score {score:.2f}; {getattr(self, '_turn_why', '')})")
                     continue
                 score -= 0.1 * travel
+            tried.append(f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})")
             if score > best_score:
-                best, best_score = pose, score
+                best, best_score, best_slide = pose, score, shift - lateral
         if best is None and fallback is not None:
             self.ctx.recorder.event("warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly")
-            best = fallback
+            best, best_slide = fallback, fallback_slide
+        self.ctx.recorder.event("grip_choice", hand=hand.side, face=world_dir, candidates=tried,
+                                chosen=None if best is None else
+                                f"pinch {_axis_name(pinch_axis(best))} thumb {_axis_name(best.rotation.apply([0.0, 1.0, 0.0]))}")
         if best is None:
             raise StrategyFailure("unreachable", f"{hand.side} arm: no push-grasp from {world_dir} reachable")
+        hand.slide = best_slide
         return best
+
+    def _clear_lateral(self, hand: Hand, face_pose: Pose, nominal: float) -> float | None:
+        """Lateral offset (tool y, m) of a parallel take whose closing fingers clear the other hand's fingers.
+
+        The other hand's outer finger links are placed from its own measured
+        kinematics relative to its *believed* (commanded) tool pose, and seen
+        from the candidate frame ``face_pose`` (tool frame on the face
+        centre). The offset nearest ``nominal`` is chosen among those that
+        keep the fingers on the face (``max_lateral``) and the thumb's tip
+        ``thumb_edge_margin`` inside the face edge; None if none does.
+        """
+        cfg = self.config
+        other = self._other(hand)
+        prefix = other.arm.config.tcp_link.split("_")[0] + "_bh_finger_"
+        links = [(self.b.get_link_pose(self.robot.body, f"{prefix}{f}{n}_link"), PROX_CORNERS if n == 2 else DIST_CORNERS)
+                 for f in (1, 2) for n in (2, 3)]
+        lo, hi = finger_extent(other.cmd, other.arm.tcp_pose(), links, face_pose)
+
+        def ok(t: float) -> bool:
+            return (abs(t + hand.thumb_lateral) <= CUBE_HALF - cfg.thumb_edge_margin
+                    and band_clear(lo, hi, t, cfg.finger_half_width, cfg.finger_reach, cfg.handover_clearance))
+
+        if ok(nominal):
+            return nominal
+        feasible = [float(t) for t in np.arange(-cfg.max_lateral, cfg.max_lateral + 1e-9, 0.001) if ok(float(t))]
+        return min(feasible, key=lambda t: abs(t - nominal)) if feasible else None
 
     def _turn_travel(self, hand: Hand, base: Pose, grip: Pose, q: np.ndarray, axis: str, angle: float) -> float | None:
         n = max(1, self.config.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
@@ -314,10 +380,10 @@ class PushGraspStrategy:
         for i in range(1, n + 1):
             pose = rotate_about_point(grip, self.est.p, axis, angle * i / n)
             res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q)
-            if not res.success[0]:
-                return None
             jump = float(np.max(np.abs(res.q[0] - q)))
-            if jump > self.config.max_waypoint_jump:
+            if not res.success[0] or jump > self.config.max_waypoint_jump:
+                # diagnostic for the grip_choice event
+                self._turn_why = f"waypoint {i}/{n}: IK {bool(res.success[0])}, joint step {jump:.2f} rad"
                 return None
             total += jump
             q = res.q[0]
@@ -340,6 +406,9 @@ class PushGraspStrategy:
         grip = self._choose_grip(hand, world_dir, twist_delta, horizontal_pinch, turn, perpendicular, parallel)
         z = approach_axis(grip)
         far = Pose(grip.p - cfg.far_distance * z, grip.q)
+        if self._other(hand).holding and not hand.holding and \
+                np.linalg.norm(hand.cmd.p - self.est.p) < cfg.swing_radius:
+            self._swing_round(hand, far, label)
         if np.linalg.norm(far.p - hand.cmd.p) > 0.01 or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999:
             self._send(hand, far, label=f"{label} stand-off", settle=0.05)
         start = Pose(grip.p - cfg.push_start * z, grip.q)
@@ -378,6 +447,90 @@ class PushGraspStrategy:
         hand.last_grip = hand.cmd
         hand.cube_in_tcp = hand.cmd.inv() * self.est
         hand.grip_dir, hand.depth = world_dir, depth
+
+    def _swing_round(self, hand: Hand, far: Pose, label: str) -> None:
+        """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed cube centre.
+
+        Why: one joint-space move from one side of the cube to another can
+        sweep the hand through the cube, or through the other hand holding it
+        alone (measured: a hand-over re-grip's swing from beside the cube to
+        behind it knocked the taker's thumb and the cube fell). On the arc the
+        tool frame stays at the retreat / stand-off distance from the cube's
+        centre, facing it, and each joint-space move turns it at most
+        ``swing_step_deg``. The direct arc is tried first, then two-leg arcs
+        through its middle, over the top, under or diagonally, with the wrist
+        rolled 0, +-90 or 180 deg there (a hand in front of the cube near the
+        torso cannot turn round it directly). The whole arc must be reachable
+        on the arm's branch (joint steps under ``swing_max_joint_step``), or
+        the hand moves as before (one joint-space move, with a warning).
+        """
+        c = self.est.p
+        start = hand.cmd
+        r0, r1 = float(np.linalg.norm(start.p - c)), float(np.linalg.norm(far.p - c))
+        u0, u1 = (start.p - c) / r0, (far.p - c) / r1
+        if math.degrees(math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))) < 2 * self.config.swing_step_deg:
+            return
+        up = np.array([0.0, 0.0, 1.0])
+        routes: list[tuple[list, list]] = [([u0, u1], [start.rotation, far.rotation])]
+        mid = u0 + u1
+        mid = mid / np.linalg.norm(mid) if np.linalg.norm(mid) > 1e-6 else np.cross(u0, up)
+        vias = [mid]
+        if abs(float(np.dot(u0, up))) < 0.9 and abs(float(np.dot(u1, up))) < 0.9:
+            vias += [up, mid - up, -up, mid + up]
+        for via in vias:
+            via = via / np.linalg.norm(via)
+            top = _turn_between(u0, via) * start.rotation
+            for roll in (0.0, math.pi / 2, -math.pi / 2, math.pi):
+                routes.append(([u0, via, u1], [start.rotation, top * Rotation.from_rotvec([0.0, 0.0, roll]),
+                                               far.rotation]))
+        base = hand.arm.base_pose()
+        why = ""
+        for dirs, rots in routes:
+            poses = self._arc(c, dirs, rots, r0, r1)
+            q, ok = hand.arm.positions(), True
+            for pose in poses + [far]:
+                res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q)
+                step = float(np.max(np.abs(res.q[0] - q)))
+                if not res.success[0] or step > self.config.swing_max_joint_step:
+                    why += (f" {len(dirs) - 1}-leg arc: waypoint {np.round(pose.p, 3).tolist()} IK "
+                            f"{bool(res.success[0])}, joint step {step:.2f} rad;")
+                    ok = False
+                    break
+                q = res.q[0]
+            if ok:
+                self.ctx.recorder.event("swing", hand=hand.side, label=label, legs=len(dirs) - 1,
+                                        waypoints=len(poses))
+                for pose in poses:
+                    self._send(hand, pose, label=f"{label} swing", settle=0.0)
+                return
+        self.ctx.recorder.event("warning", message=f"{hand.side}: {label}: no arc round the cube on the arm's "
+                                f"branch ({why.strip()}); one joint-space move to the stand-off")
+
+    def _arc(self, c: np.ndarray, dirs: list, rots: list, r0: float, r1: float) -> list[Pose]:
+        """Waypoints (tool poses) on great-circle legs through the unit directions ``dirs`` from ``c``.
+
+        At each direction the tool has the orientation ``rots[i]``; within a
+        leg the orientation is slerped. The distance from ``c`` goes linearly
+        from ``r0`` to ``r1`` over the legs. The end points are not included.
+        """
+        from scipy.spatial.transform import Slerp
+
+        angles = [math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0))) for a, b in zip(dirs[:-1], dirs[1:])]
+        total = sum(angles)
+        step = math.radians(self.config.swing_step_deg)
+        out, done = [], 0.0
+        for leg, (a, ang) in enumerate(zip(dirs[:-1], angles)):
+            turn = _turn_between(a, dirs[leg + 1])
+            axis = turn.as_rotvec() / max(ang, 1e-9)
+            slerp = Slerp([0.0, 1.0], Rotation.concatenate([rots[leg], rots[leg + 1]]))
+            n = max(1, int(math.ceil(ang / step)))
+            last = leg == len(angles) - 1
+            for i in range(1, n + (0 if last else 1)):
+                s = (done + ang * i / n) / total
+                p = c + Rotation.from_rotvec(axis * ang * i / n).apply(a) * ((1 - s) * r0 + s * r1)
+                out.append(Pose.from_rotation(p, slerp([i / n])[0]))
+            done += ang
+        return out
 
     def _slabs_touched(self, body_axis: str) -> dict:
         """Diagnostic for the recorder: which slabs each hand's links touch (engine contacts)."""
@@ -475,6 +628,17 @@ class PushGraspStrategy:
     def _twist(self, t: Twist, orientation, k: int) -> None:
         cube, rec = self.cube, self.ctx.recorder
         rot, hold = self.hands[t.gripper], self._other(self.hands[t.gripper])
+        if rot.holding and hold.holding and hold.depth == 2:
+            # the holder holds and the rotator lets go and grips again (a fresh choice, with wrist room) when a
+            # hand-over take left it where the wrist cannot roll the twist (its fingers had to clear the giver's),
+            # or slid off its face centre: the wrist would roll the layer about an axis off the cube's, and the
+            # layer orbits and drags the held one (measured: D2 after a 15 mm slide dragged it 27 deg, SAPIEN)
+            q7 = float(rot.arm.positions()[-1]) + self._roll_delta(t)
+            if (rot.depth != 1 or not rot.arm.lower[-1] <= q7 <= rot.arm.upper[-1]
+                    or abs(rot.slide) > self.config.max_twist_slide):
+                rec.event("rotator_regrip", hand=rot.side, depth=rot.depth, q7_after_twist=q7,
+                          slide_mm=1000 * rot.slide)
+                self._release_hand(rot)
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             if hold.holding and hold.depth == 2 and not rot.holding:
                 self._push_grasp(rot, SIDE_DIR[rot.side], 1, "re-grip", self._roll_delta(t))
@@ -543,9 +707,11 @@ class PushGraspStrategy:
         # taker's finger 2 stopped on it): once the taker's thumb is on its face, the giver straightens it
         straighten = (lambda: self._straighten_thumb(giver)) if cfg.giver_retracts_thumb else None
         # the taker pinches the two faces the giver pinches, on its own side of them: the giver's thumb and
-        # palm are on the face across (measured: crossing, the taker's finger 2 stopped on the giver's thumb)
-        self._push_grasp(taker, SIDE_DIR[taker.side], tdepth, "hand-over take",
-                         self._next_twist_delta(k, taker.side) if tdepth == 1 else 0.0, k=k,
+        # palm are on the face across (measured: crossing, the taker's finger 2 stopped on the giver's thumb);
+        # where the giver's fingers reach the taker's, the take slides across its face to clear them
+        # (_clear_lateral), and a slid rotator grips again before its twist (_twist)
+        delta = self._next_twist_delta(k, taker.side) if tdepth == 1 else 0.0
+        self._push_grasp(taker, SIDE_DIR[taker.side], tdepth, "hand-over take", delta, k=k,
                          perpendicular=not cfg.taker_parallel, parallel=cfg.taker_parallel, before_close=straighten)
         self._release_hand(giver, retreat=0.12)
         gdepth = 3 - tdepth
