@@ -90,6 +90,24 @@ def test_own_body_is_ignored_and_other_bodies_are_reported(backend):
     assert r.body[0] == blocker and r.true_distance[0] == pytest.approx(0.018, abs=1e-3)
 
 
+def test_a_sensor_on_one_link_sees_the_rest_of_its_robot(backend):
+    """A ToF window in one pad looking across the gap: with only its own link ignored it ranges the other pad."""
+    from pathlib import Path
+
+    urdf = Path(__file__).resolve().parents[1] / "backends" / "assets" / "gripper.urdf"
+    grip = backend.load_urdf(urdf, Pose(), fixed_base=True, name="gripper")
+    q = 0.04  # each pad's inner face at q - 9 mm from the centre plane (the rig's URDF)
+    backend.set_joint_positions(grip, [0.2, q, q], joints=["lift", "left_finger", "right_finger"])
+    backend.step(1)  # PhysX's scene queries see a joint teleport only after a step (docs/backends.md)
+    across = [Emitter((0.0, 0.0, 0.0), (0.0, -1.0, 0.0))]  # from pad_l's centre towards pad_r
+    whole = PreTouchSensor(backend, grip, "pad_l", across)
+    assert not np.isfinite(whole.read(np.random.default_rng(0)).true_distance[0])  # the robot is transparent
+    own = PreTouchSensor(backend, grip, "pad_l", across, ignore_bodies=(), ignore_links=((grip, "pad_l"),))
+    r = own.read(np.random.default_rng(0))
+    assert r.body[0] == grip
+    assert r.true_distance[0] == pytest.approx(0.002 + 2 * (q - 0.009), abs=1e-3)  # half pad + the gap
+
+
 def test_emitters_follow_the_link_pose_and_belief(backend):
     _wall(backend)
     body, sensor = _sensor_at(backend, WALL_X - 0.05, [Emitter((0.01, 0.0, 0.0), (1.0, 0.0, 0.0))])

@@ -82,6 +82,7 @@ class PreTouchSensor:
         config: ToFConfig | None = None,
         *,
         ignore_bodies: Iterable[BodyId] | None = None,
+        ignore_links: Iterable[tuple[BodyId, str | None]] = (),
     ) -> None:
         if not emitters:
             raise ValueError("a PreTouchSensor needs at least one Emitter")
@@ -92,11 +93,12 @@ class PreTouchSensor:
         self.config = config or ToFConfig()
         #: Bodies the rays pass through. The mounting body by default: the
         #: window sits in the finger, and a ray must not hit its own finger.
-        #: ``ray_cast`` ignores whole bodies, so on a robot this makes the whole
-        #: robot transparent to its own sensors; pass ``ignore_bodies=()`` and
-        #: put the emitter origins just outside the finger's collision shape
-        #: for a robot that can see its other finger.
+        #: On a robot that makes the whole robot transparent to its own
+        #: sensors; for a robot that sees its other finger (or its other arm),
+        #: pass ``ignore_bodies=()`` and ``ignore_links=((body, link),)``: the
+        #: rays then pass only through the mounting link.
         self.ignore_bodies = tuple(ignore_bodies) if ignore_bodies is not None else (body,)
+        self.ignore_links = tuple(ignore_links)
         self._o = np.array([e.origin for e in self.emitters], dtype=float)
         d = np.array([e.direction for e in self.emitters], dtype=float)
         self._d = d / np.linalg.norm(d, axis=1, keepdims=True)
@@ -123,7 +125,8 @@ class PreTouchSensor:
         o, d = self.rays(true_pose)
         # The range window applies to the true range (whether light comes back);
         # noise is added after, so a reading near a limit may stray past it.
-        hits = self.backend.ray_cast(o, d, cfg.max_range, ignore_bodies=self.ignore_bodies)
+        hits = self.backend.ray_cast(o, d, cfg.max_range, ignore_bodies=self.ignore_bodies,
+                                     ignore_links=self.ignore_links)
         true_d = np.where(hits.hit & (hits.distance <= cfg.max_range), hits.distance, np.inf)
         noise = rng.standard_normal(len(true_d))  # drawn for every ray: same stream whatever is hit
         finite = np.isfinite(true_d)
