@@ -220,3 +220,31 @@ def test_one_method_is_one_column_across_tiers_with_their_own_default_budgets(in
     data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
     labels = {lab for row in data["rows"] for lab in row["ours"]}
     assert len(labels) == 3 and all(lab.startswith("test-timed (test-stub, pybullet) options ") for lab in labels)
+
+
+def test_a_sweep_straddling_a_commit_is_one_column_and_a_rerun_at_another_commit_splits(invoke, monkeypatch):
+    from benchharness.runner.spec import code_version
+
+    def at(version: str) -> None:
+        monkeypatch.setenv("BENCHHARNESS_CODE_VERSION", version)
+        code_version.cache_clear()
+
+    try:
+        at("0.1.0+gaaaa")
+        assert invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE).exit_code == 0
+        at("0.1.0+gbbbb")
+        assert invoke(run, "--task", "Rubiks-1-10", "--strategy", "test-timed", *BASE).exit_code == 0
+        res = invoke(table, "--run-tiers")
+        data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
+        assert [c["code_version"] for c in data["columns"]] == ["0.1.0+gaaaa, 0.1.0+gbbbb"]
+        assert {lab for row in data["rows"] for lab in row["ours"]} == {"test-timed (test-stub, pybullet)"}
+        assert "runs from code versions 0.1.0+gaaaa, 0.1.0+gbbbb" in res.output
+        # the same tier again at a third commit: that method's runs split by code version
+        at("0.1.0+gcccc")
+        assert invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE).exit_code == 0
+        data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
+        labels = {lab for row in data["rows"] for lab in row["ours"]}
+        assert labels == {f"test-timed (test-stub, pybullet) code 0.1.0+g{v}" for v in ("aaaa", "bbbb", "cccc")}
+    finally:
+        monkeypatch.delenv("BENCHHARNESS_CODE_VERSION")
+        code_version.cache_clear()

@@ -369,6 +369,9 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
             console.print(t)
             if not tab.columns:
                 console.print("No Rubik's results in the store yet (benchharness run --task Rubiks-...).")
+            for c in tab.columns:
+                if "," in c.code_version:
+                    console.print(f"{_esc(c.label)}: runs from code versions {c.code_version}")
     if "inhand" in wanted:
         t2, t3 = inhand_table2(trials), inhand_table3(trials, contact_scorer=_contact_scorer())
         if as_json:

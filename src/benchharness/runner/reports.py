@@ -68,26 +68,33 @@ class Column:
 def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Column]]:
     """Columns in first-seen order, labelled as briefly as still tells them apart.
 
-    Run options (budgets, repeats) split a method into two columns only where
-    the same task was run with different options: the default simulated-time
-    budget grows with a tier's moves, so every tier of one method has its own
-    options hash and must still land in one column.
+    Run options (budgets, repeats) and code versions split a method into
+    several columns only where the same task was run with different ones:
+    the default simulated-time budget grows with a tier's moves, so every tier
+    of one method has its own options hash and must still land in one column,
+    and a sweep whose tiers straddle a commit is still one method. A merged
+    column's ``code_version`` lists every version in it (comma-separated), so
+    nothing is hidden; ``table`` prints them under the table.
     """
     trials = list(trials)
 
     def method_key(t: StoredTrial) -> tuple:
-        return (t.robot, t.strategy, t.sensors, t.backend, t.seed, t.physics_hash, t.code_version)
+        return (t.robot, t.strategy, t.sensors, t.backend, t.seed, t.physics_hash)
 
-    options: dict[tuple, set[str]] = {}
+    per_task: dict[tuple, set[tuple[str, str]]] = {}
     for t in trials:
-        options.setdefault((method_key(t), t.task), set()).add(t.options_hash)
-    split = {mk for (mk, _), hashes in options.items() if len(hashes) > 1}
+        per_task.setdefault((method_key(t), t.task), set()).add((t.options_hash, t.code_version))
+    split_opt = {mk for (mk, _), s in per_task.items() if len({o for o, _ in s}) > 1}
+    split_code = {mk for (mk, _), s in per_task.items() if len({c for _, c in s}) > 1}
     raw: dict[tuple, StoredTrial] = {}
+    codes: dict[tuple, list[str]] = {}
     by_run: dict[str, tuple] = {}
     for t in trials:
         mk = method_key(t)
-        k = (*mk[:6], t.options_hash if mk in split else "", mk[6])
+        k = (*mk, t.options_hash if mk in split_opt else "", t.code_version if mk in split_code else "")
         raw.setdefault(k, t)
+        if t.code_version not in codes.setdefault(k, []):
+            codes[k].append(t.code_version)
         by_run[t.run_key] = k
     base: dict[tuple, str] = {k: t.method for k, t in raw.items()}
     labels: dict[tuple, str] = {}
@@ -95,12 +102,12 @@ def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Col
         same = [o for o, lab in base.items() if lab == base[k] and o != k]
         extra = []
         for f in _DISTINGUISH:
-            if f == "options_hash" and not k[6]:
+            if (f == "options_hash" and not k[6]) or (f == "code_version" and not k[7]):
                 continue
             if any(getattr(raw[o], f) != getattr(t, f) for o in same):
                 extra.append(f"seed {t.seed}" if f == "seed" else f"{f.split('_')[0]} {getattr(t, f)}")
         labels[k] = base[k] + (" " + ", ".join(extra) if extra else "")
-    cols = {k: Column(labels[k], *k) for k in raw}
+    cols = {k: Column(labels[k], *k[:7], ", ".join(codes[k])) for k in raw}
     return list(cols.values()), {run: cols[k] for run, k in by_run.items()}
 
 
