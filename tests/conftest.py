@@ -44,3 +44,31 @@ def pytest_collection_modifyitems(config, items):
         used = {v for v in params.values() if isinstance(v, str) and v in BACKEND_NAMES}
         if used and not used <= wanted:
             item.add_marker(pytest.mark.skip(reason=f"backend not in BENCHHARNESS_BACKENDS={sorted(wanted)}"))
+
+
+@pytest.fixture
+def make_backend():
+    """make_backend(name) -> a fresh backend from the plugin manager; closed after the test."""
+    from benchharness.plugin import get_manager
+
+    made = []
+
+    def _make(name: str):
+        be = get_manager().create("backend", name)
+        made.append(be)
+        return be
+
+    yield _make
+    for be in made:
+        be.close()
+
+
+@pytest.fixture
+def make_robot():
+    """make_robot(name, **kwargs) -> a fresh robot object from the plugin manager."""
+    from benchharness.plugin import get_manager
+
+    def _make(name: str, **kwargs):
+        return get_manager().create("robot", name, **kwargs)
+
+    return _make

@@ -26,27 +26,5 @@ def robots(manager):
     return {n: manager.create("robot", n) for n in ROBOTS}
 
 
-@pytest.fixture
-def make_backend(manager):
-    made = []
-
-    def _make(name: str):
-        be = manager.create("backend", name)
-        made.append(be)
-        return be
-
-    yield _make
-    for be in made:
-        be.close()
-
-
-@pytest.fixture
-def make_robot(manager):
-    def _make(name: str, **kwargs):
-        return manager.create("robot", name, **kwargs)
-
-    return _make
-
-
 def rng(seed: int) -> np.random.Generator:
     return np.random.default_rng(seed)

@@ -24,29 +24,6 @@ CUBE_HALF = 0.0285
 BELIEF_ERROR = 0.008  # m, along the approach; 2-3 x what the head camera gives
 
 
-@pytest.fixture
-def make_backend():
-    from benchharness.plugin import get_manager
-
-    made = []
-
-    def _make(name: str):
-        be = get_manager().create("backend", name)
-        made.append(be)
-        return be
-
-    yield _make
-    for be in made:
-        be.close()
-
-
-@pytest.fixture
-def make_robot():
-    from benchharness.plugin import get_manager
-
-    return lambda name: get_manager().create("robot", name)
-
-
 def test_registered_for_herb_and_refuses_other_robots(make_ctx):
     from benchharness.plugin import get_manager
 
