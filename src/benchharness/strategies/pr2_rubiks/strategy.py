@@ -501,12 +501,21 @@ class DeadReckoningStrategy:
         self._send(picker, up, label="lift")
         there = Pose(picker.cmd.p + [lift[0], lift[1], -0.03], picker.cmd.q)
         self._send(picker, there, label="carry")
-        if a.rotator == a.gripper:
-            self._grip(other, SIDE_DIR[other.side], 2, "second grasp", k=k, perpendicular=True)
-            self._release_hand(picker)
-            self._grip(picker, SIDE_DIR[picker.side], 1, "pick shift out")
+        self._join(picker, other, a.rotator, "second grasp", "pick shift out", k)
+
+    def _join(self, alone: Hand, free: Hand, rotator: str, label: str, shift_label: str, k: int) -> None:
+        """The free hand joins the hand holding alone (two slabs deep) so that the next rotator holds one slab.
+
+        If the lone holder rotates next, the free hand grips two slabs deep, fingers crossing (it
+        becomes the holder), and the lone hand lets go and slides out to one slab; otherwise the free
+        hand grips one slab deep.
+        """
+        if rotator == alone.side:
+            self._grip(free, SIDE_DIR[free.side], 2, label, k=k, perpendicular=True)
+            self._release_hand(alone)
+            self._grip(alone, SIDE_DIR[alone.side], 1, shift_label)
         else:
-            self._grip(other, SIDE_DIR[other.side], 1, "second grasp", k=k)
+            self._grip(free, SIDE_DIR[free.side], 1, label, k=k)
 
     def _twist(self, t: Twist, orientation, k: int) -> None:
         cube, rec = self.cube, self.ctx.recorder
@@ -574,12 +583,7 @@ class DeadReckoningStrategy:
         self._grip(taker, SIDE_DIR[taker.side], 2, "hand-over take", k=k, perpendicular=True)
         self._release_hand(giver, retreat=self.handover_retreat)
         self._judge("hand-over given", taker)
-        if a.rotator == taker.side:
-            self._grip(giver, SIDE_DIR[giver.side], 2, "hand-over re-grip", k=k, perpendicular=True)
-            self._release_hand(taker)
-            self._grip(taker, SIDE_DIR[taker.side], 1, "hand-over shift out")
-        else:
-            self._grip(giver, SIDE_DIR[giver.side], 1, "hand-over re-grip", k=k)
+        self._join(taker, giver, a.rotator, "hand-over re-grip", "hand-over shift out", k)
 
     def _release(self) -> None:
         for hand in self.hands.values():
