@@ -26,16 +26,18 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "backends"))
 
-from backend_scenes import GRASP_Z, grasp_lift_hold, gripper_scene  # noqa: E402
+from backend_scenes import GRASP_Z, grasp_lift_hold, gripper_scene
 
-from benchharness.backends import PhysicsConfig  # noqa: E402
-from benchharness.plugin import get_manager  # noqa: E402
+from benchharness.backends import PhysicsConfig
+from benchharness.plugin import get_manager
 
 
 def bench(name: str, iterations: int, seconds: float) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        b = get_manager().create("backend", name, config=PhysicsConfig(solver_iterations=iterations))
+        b = get_manager().create(
+            "backend", name, config=PhysicsConfig(solver_iterations=iterations)
+        )
     try:
         s = gripper_scene(b)
         grasp_lift_hold(s, hold_s=0.2)  # holding the cube in the air
@@ -66,24 +68,37 @@ def bench(name: str, iterations: int, seconds: float) -> dict:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per measurement")
-    ap.add_argument("--iterations", type=int, nargs="+", default=[50, 20], help="solver iterations to try")
+    ap.add_argument(
+        "--iterations", type=int, nargs="+", default=[50, 20], help="solver iterations to try"
+    )
     ap.add_argument("--backends", nargs="+", default=None, help="default: every registered backend")
     args = ap.parse_args()
     names = args.backends or get_manager().names("backend")
-    print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
-          f"timestep 1/240 s, {args.seconds} s simulated per figure")
-    print(f"# load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; CPU = steps per CPU second (process_time)")
-    print("| backend | solver iterations | step(n) steps/s | step(n) CPU steps/s | step(n) real-time factor | "
-          "control loop steps/s | control loop CPU steps/s | control loop real-time factor | cube still held |")
+    print(
+        f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
+        f"timestep 1/240 s, {args.seconds} s simulated per figure"
+    )
+    print(
+        f"# load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; CPU = steps per CPU second (process_time)"
+    )
+    print(
+        "| backend | solver iterations | step(n) steps/s | step(n) CPU steps/s | step(n) real-time factor | "
+        "control loop steps/s | control loop CPU steps/s | control loop real-time factor | cube still held |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for name in names:
         for it in args.iterations:
             r = bench(name, it, args.seconds)
-            print(f"| {r['backend']} | {r['iterations']} | {r['raw_steps_s']:,.0f} | {r['raw_cpu_steps_s']:,.0f} | "
-                  f"{r['raw_rtf']:.1f} | {r['ctl_steps_s']:,.0f} | {r['ctl_cpu_steps_s']:,.0f} | {r['ctl_rtf']:.1f} | "
-                  f"{'yes' if r['held'] else 'NO'} |", flush=True)
+            print(
+                f"| {r['backend']} | {r['iterations']} | {r['raw_steps_s']:,.0f} | {r['raw_cpu_steps_s']:,.0f} | "
+                f"{r['raw_rtf']:.1f} | {r['ctl_steps_s']:,.0f} | {r['ctl_cpu_steps_s']:,.0f} | {r['ctl_rtf']:.1f} | "
+                f"{'yes' if r['held'] else 'NO'} |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -29,7 +29,16 @@ import time
 
 import numpy as np
 
-from benchharness.cube import ALL_MOVES, FACE_MOVES, MOVE_PERMUTATIONS, SOLVED, apply, apply_batch, to_string, to_strings
+from benchharness.cube import (
+    ALL_MOVES,
+    FACE_MOVES,
+    MOVE_PERMUTATIONS,
+    SOLVED,
+    apply,
+    apply_batch,
+    to_string,
+    to_strings,
+)
 from benchharness.cube.moves import permutation
 
 
@@ -43,7 +52,9 @@ def best_of(fn, repeat: int) -> tuple[float, object]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--sequences", type=int, default=10_000)
     ap.add_argument("--length", type=int, default=20)
     ap.add_argument("--single-moves", type=int, default=100_000)
@@ -55,7 +66,12 @@ def main() -> None:
     from magiccube.cube_move import CubeMove
 
     rng = random.Random(args.seed)
-    idx = np.array([[rng.randrange(len(FACE_MOVES)) for _ in range(args.length)] for _ in range(args.sequences)])
+    idx = np.array(
+        [
+            [rng.randrange(len(FACE_MOVES)) for _ in range(args.length)]
+            for _ in range(args.sequences)
+        ]
+    )
     face_index = np.array([m.index for m in FACE_MOVES])
     idx = face_index[idx]
     texts = [" ".join(str(ALL_MOVES[j]) for j in row) for row in idx]
@@ -109,15 +125,21 @@ def main() -> None:
         (f"{n:,} × {L}-move sequences, batched (N, {L}) array", t_batch, t_magic),
         (f"{n_single:,} single moves, one at a time", t_s_ours, t_s_magic),
     ]
-    print(f"python {platform.python_version()}, numpy {np.__version__}, magiccube 1.2, "
-          f"{platform.machine()}, best of {args.repeat}")
+    print(
+        f"python {platform.python_version()}, numpy {np.__version__}, magiccube 1.2, "
+        f"{platform.machine()}, best of {args.repeat}"
+    )
     print(f"{'case':<48}{'ours':>12}{'magiccube':>12}{'speed-up':>10}")
     for name, ours, magic in rows:
         print(f"{name:<48}{ours:>11.3f}s{magic:>11.3f}s{magic / ours:>9.0f}×")
     print(f"{'':<48}{'per item':>12}")
-    print(f"{'sequence (ours, one at a time)':<48}{t_ours / n * 1e6:>10.1f}µs{t_magic / n * 1e6:>10.0f}µs")
+    print(
+        f"{'sequence (ours, one at a time)':<48}{t_ours / n * 1e6:>10.1f}µs{t_magic / n * 1e6:>10.0f}µs"
+    )
     print(f"{'sequence (ours, batched)':<48}{t_batch / n * 1e6:>10.2f}µs")
-    print(f"{'single move':<48}{t_s_ours / n_single * 1e6:>10.2f}µs{t_s_magic / n_single * 1e6:>10.1f}µs")
+    print(
+        f"{'single move':<48}{t_s_ours / n_single * 1e6:>10.2f}µs{t_s_magic / n_single * 1e6:>10.1f}µs"
+    )
     print(f"{'compose only (parse + 20 index ops)':<48}{t_compose / n * 1e6:>10.1f}µs")
 
 

@@ -36,9 +36,8 @@ PUBLISHED = {
 
 
 def main(argv=None) -> int:
-    from benchharness.inhand.fileformat import read_results, read_tasks
+    from benchharness.inhand.fileformat import read_results, read_tasks, write_results
     from benchharness.inhand.scoring import score_results
-    from benchharness.inhand.fileformat import write_results
     from benchharness.strategies.dmg.runner import (
         DESIRED_REGION_RADIUS,
         FINGER_PAD_RADIUS,
@@ -51,7 +50,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tasks", default=str(ROOT / "tasks/inhand/level3_dmg_tasks.csv"))
     ap.add_argument("--published", default=str(ROOT / "tasks/inhand/published/yumi_lvl3_dmg.csv"))
-    ap.add_argument("--out", default="/tmp/benchharness-dmg", help="folder for results.csv and meshes/")
+    ap.add_argument(
+        "--out", default="/tmp/benchharness-dmg", help="folder for results.csv and meshes/"
+    )
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
 
@@ -77,10 +78,13 @@ def main(argv=None) -> int:
     pub = read_results(args.published)
     pub_rows = [list(pub.task_id).index(p.task_id) for p in plans]
     pub_grasps = [
-        ReachedGrasp(p.task_id, p.object, pub.contacts["reached"][j, :2], pub.reached[j]) for p, j in zip(plans, pub_rows)
+        ReachedGrasp(p.task_id, p.object, pub.contacts["reached"][j, :2], pub.reached[j])
+        for p, j in zip(plans, pub_rows)
     ]
     pub_path = out / "published_on_our_meshes.csv"
-    write_results(results_for_grasps(tasks, pub_grasps, planner, out, "DMG (paper, our meshes)"), pub_path)
+    write_results(
+        results_for_grasps(tasks, pub_grasps, planner, out, "DMG (paper, our meshes)"), pub_path
+    )
     ps = score_results(read_results(pub_path)).scores
 
     cols = [f"{p.object}" for p in plans]
@@ -121,12 +125,15 @@ def main(argv=None) -> int:
             cells.append(cell)
         print(f"| {name} | " + " | ".join(cells) + " |")
     print()
-    print("| task | reached goal node | primitives | translation (cm) | rotation (deg) | patches | states | edges |")
+    print(
+        "| task | reached goal node | primitives | translation (cm) | rotation (deg) | patches | states | edges |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for p in plans:
         g = planner.graph(p.object)
         prims = " ".join(
-            f"T{q.length * 100:.1f}" if q.kind == "translate" else f"R{np.degrees(q.angle):+.1f}" for q in p.plan.primitives
+            f"T{q.length * 100:.1f}" if q.kind == "translate" else f"R{np.degrees(q.angle):+.1f}"
+            for q in p.plan.primitives
         )
         print(
             f"| {p.task_id} | {p.plan.reached_goal} | {prims} | {p.plan.translation_length * 100:.1f} | "

@@ -51,9 +51,13 @@ def timeit(fn, repeats: int) -> tuple[float, float]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--subdivisions", type=int, default=5)
-    ap.add_argument("--pairs", type=int, default=40, help="random vertex pairs for the agreement check")
+    ap.add_argument(
+        "--pairs", type=int, default=40, help="random vertex pairs for the agreement check"
+    )
     ap.add_argument("--cases", type=int, default=10, help="random region/contact cases")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
@@ -62,16 +66,28 @@ def main() -> None:
     mesh = make_mesh(args.subdivisions)
     surf = ObjectSurface(mesh)
     cases = [random_case(surf, rng) for _ in range(args.cases)]
-    print(f"mesh: {len(mesh.vertices)} vertices, {len(mesh.faces)} faces, "
-          f"mean edge {surf.mean_edge * 1000:.2f} mm, G_min {surf.g_min * 1000:.2f} mm")
-    print(f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}")
+    print(
+        f"mesh: {len(mesh.vertices)} vertices, {len(mesh.faces)} faces, "
+        f"mean edge {surf.mean_edge * 1000:.2f} mm, G_min {surf.g_min * 1000:.2f} mm"
+    )
+    print(
+        f"machine: {platform.processor() or platform.machine()}, python {platform.python_version()}"
+    )
 
     region, contacts = cases[0]
-    cold = timeit(lambda: contact_region_error(ObjectSurface(mesh), region, contacts, method="heat"), 5)
+    cold = timeit(
+        lambda: contact_region_error(ObjectSurface(mesh), region, contacts, method="heat"), 5
+    )
     contact_region_error(surf, region, contacts, method="heat")  # warm the cache
-    warm = [timeit(lambda r=r, c=c: contact_region_error(surf, r, c, method="heat"), 5)[0] for r, c in cases]
+    warm = [
+        timeit(lambda r=r, c=c: contact_region_error(surf, r, c, method="heat"), 5)[0]
+        for r, c in cases
+    ]
     contact_region_error(surf, region, contacts, method="exact")  # build the exact solver once
-    exact = [timeit(lambda r=r, c=c: contact_region_error(surf, r, c, method="exact"), 1)[0] for r, c in cases]
+    exact = [
+        timeit(lambda r=r, c=c: contact_region_error(surf, r, c, method="exact"), 1)[0]
+        for r, c in cases
+    ]
 
     print("\n| evaluation (Algorithm 1, one trial) | median time |")
     print("| --- | --- |")
@@ -86,15 +102,19 @@ def main() -> None:
     e = np.array([surf.geodesic_to_set([a], [b], "exact")[0] for a, b in zip(i, j)])
     ok = e > 5 * surf.mean_edge  # relative error is meaningless for neighbours
     rel = np.abs(h[ok] - e[ok]) / e[ok]
-    print(f"\nvertex pairs: n={ok.sum()} (exact distance > 5 edges), heat vs exact relative error: "
-          f"mean {rel.mean() * 100:.2f} %, max {rel.max() * 100:.2f} %")
+    print(
+        f"\nvertex pairs: n={ok.sum()} (exact distance > 5 edges), heat vs exact relative error: "
+        f"mean {rel.mean() * 100:.2f} %, max {rel.max() * 100:.2f} %"
+    )
 
     # agreement of Algorithm 1 max_d
     hd = np.array([contact_region_error(surf, r, c, method="heat").geo for r, c in cases])
     ed = np.array([contact_region_error(surf, r, c, method="exact").geo for r, c in cases])
     rel = np.abs(hd - ed) / ed
-    print(f"Algorithm-1 max_d over {len(cases)} region/contact cases: heat vs exact relative error "
-          f"mean {rel.mean() * 100:.2f} %, max {rel.max() * 100:.2f} %")
+    print(
+        f"Algorithm-1 max_d over {len(cases)} region/contact cases: heat vs exact relative error "
+        f"mean {rel.mean() * 100:.2f} %, max {rel.max() * 100:.2f} %"
+    )
 
 
 if __name__ == "__main__":

@@ -47,8 +47,8 @@ from dataclasses import replace
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-import torch  # noqa: E402
+import numpy as np
+import torch
 
 torch.set_num_threads(1)
 
@@ -67,9 +67,16 @@ def build_scene(backend_name: str, config: PhysicsConfig):
     robot.spawn(be)
     tcp = robot.arm("left_arm").tcp_pose()
     top = tcp.p[2] - CUBE_HALF
-    be.add_body([Box((0.25, 0.4, top / 2))], Pose([0.95, 0.0, top / 2]), 20.0, fixed=True, name="table")
-    cube = be.add_body([Box((CUBE_HALF,) * 3)], Pose([0.85, 0.0, top + CUBE_HALF + 5e-4]), CUBE_MASS,
-                       friction=1.0, name="cube")
+    be.add_body(
+        [Box((0.25, 0.4, top / 2))], Pose([0.95, 0.0, top / 2]), 20.0, fixed=True, name="table"
+    )
+    cube = be.add_body(
+        [Box((CUBE_HALF,) * 3)],
+        Pose([0.85, 0.0, top + CUBE_HALF + 5e-4]),
+        CUBE_MASS,
+        friction=1.0,
+        name="cube",
+    )
     robot.settle(0.2)
     return be, robot, cube
 
@@ -83,8 +90,14 @@ def time_loop(fn, sim_seconds: float, dt: float, repeats: int = 1) -> dict:
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
     wall, cpu = float(np.median(walls)), float(np.median(cpus))
-    return {"steps": steps, "wall_s": wall, "cpu_s": cpu, "steps_per_s": steps / wall,
-            "cpu_steps_per_s": steps / cpu, "real_time_factor": steps * dt / wall}
+    return {
+        "steps": steps,
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "steps_per_s": steps / wall,
+        "cpu_steps_per_s": steps / cpu,
+        "real_time_factor": steps * dt / wall,
+    }
 
 
 def _engine_step_fn(be):
@@ -100,7 +113,10 @@ def _engine_step_fn(be):
 
 def bench_backend(name: str, seconds: float, repeats: int = 1) -> dict:
     out = {}
-    for label, cfg in (("physics", PhysicsConfig()), ("physics@10it", replace(PhysicsConfig(), solver_iterations=10))):
+    for label, cfg in (
+        ("physics", PhysicsConfig()),
+        ("physics@10it", replace(PhysicsConfig(), solver_iterations=10)),
+    ):
         be, robot, cube = build_scene(name, cfg)
         dt = cfg.timestep
 
@@ -111,7 +127,9 @@ def bench_backend(name: str, seconds: float, repeats: int = 1) -> dict:
 
         out[label] = time_loop(physics, seconds, dt, repeats)
         if label == "physics":
-            out[label]["cube_speed_m_s"] = float(np.linalg.norm(be.get_velocity(cube)[0]))  # at rest: ~0
+            out[label]["cube_speed_m_s"] = float(
+                np.linalg.norm(be.get_velocity(cube)[0])
+            )  # at rest: ~0
 
             def control(sim_s, robot=robot, dt=dt):
                 robot.settle(sim_s)
@@ -141,21 +159,31 @@ def bench_ik(n: int = 1000, n_seeded: int = 200) -> dict:
     res = arm.ik(targets, seed=1)
     wall = time.perf_counter() - t0
     ok = (res.pos_error <= 1e-3) & (res.rot_error <= np.radians(1.0))
-    out = {"targets": n, "wall_s": wall, "ms_per_target": 1e3 * wall / n,
-           "converged_0.1mm": float(res.success.mean()), "within_1mm_1deg": float(ok.mean())}
+    out = {
+        "targets": n,
+        "wall_s": wall,
+        "ms_per_target": 1e3 * wall / n,
+        "converged_0.1mm": float(res.success.mean()),
+        "within_1mm_1deg": float(ok.mean()),
+    }
     # seeded single-target calls, as in a motion: seed 0.15 rad (std) from the answer
     rng = np.random.default_rng(0)
     goal = arm.chain.sample(n_seeded, torch.Generator().manual_seed(1), margin=0.2)
     seeds = np.clip(goal + rng.normal(0.0, 0.15, goal.shape), arm.lower, arm.upper)
     tg = arm.fk(goal)
     t0 = time.perf_counter()
-    rows = [arm.ik(tg[i:i + 1], seed_q=seeds[i], seed=i) for i in range(n_seeded)]
+    rows = [arm.ik(tg[i : i + 1], seed_q=seeds[i], seed=i) for i in range(n_seeded)]
     wall = time.perf_counter() - t0
     dp = np.array([r.pos_error[0] for r in rows])
     dr = np.array([r.rot_error[0] for r in rows])
-    out["seeded"] = {"calls": n_seeded, "wall_s": wall, "ms_per_call": 1e3 * wall / n_seeded,
-                     "within_1mm_1deg": float(np.mean((dp <= 1e-3) & (dr <= np.radians(1.0)))),
-                     "max_pos_error_m": float(dp.max()), "max_rot_error_rad": float(dr.max())}
+    out["seeded"] = {
+        "calls": n_seeded,
+        "wall_s": wall,
+        "ms_per_call": 1e3 * wall / n_seeded,
+        "within_1mm_1deg": float(np.mean((dp <= 1e-3) & (dr <= np.radians(1.0)))),
+        "max_pos_error_m": float(dp.max()),
+        "max_rot_error_rad": float(dr.max()),
+    }
     return out
 
 
@@ -164,33 +192,55 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=3.0, help="simulated seconds per loop")
     ap.add_argument("--json", default=None, help="also write the figures here")
     ap.add_argument("--backends", default="pybullet,sapien")
-    ap.add_argument("--repeats", type=int, default=1, help="runs per figure; the median is reported")
+    ap.add_argument(
+        "--repeats", type=int, default=1, help="runs per figure; the median is reported"
+    )
     ap.add_argument("--no-ik", action="store_true", help="skip the IK figures")
     args = ap.parse_args()
-    results = {"machine": {"cpu_count": os.cpu_count(), "python": platform.python_version(),
-                           "load_avg_1min": os.getloadavg()[0]},
-               "timestep": PhysicsConfig().timestep, "repeats": args.repeats, "backends": {}}
+    results = {
+        "machine": {
+            "cpu_count": os.cpu_count(),
+            "python": platform.python_version(),
+            "load_avg_1min": os.getloadavg()[0],
+        },
+        "timestep": PhysicsConfig().timestep,
+        "repeats": args.repeats,
+        "backends": {},
+    }
     for b in args.backends.split(","):
         results["backends"][b] = bench_backend(b, args.seconds, args.repeats)
     if not args.no_ik:
         results["ik"] = bench_ik()
     results["machine"]["load_avg_after"] = os.getloadavg()[0]
-    print(f"{'loop':14s} " + " ".join(f"{b + ' steps/s':>17s} {b + ' CPU steps/s':>21s} {b + ' RTF':>13s}"
-                                       for b in results["backends"]))
+    print(
+        f"{'loop':14s} "
+        + " ".join(
+            f"{b + ' steps/s':>17s} {b + ' CPU steps/s':>21s} {b + ' RTF':>13s}"
+            for b in results["backends"]
+        )
+    )
     for loop in ("physics", "control", "physics@10it", "engine"):
         row = []
-        for b, r in results["backends"].items():
-            row.append(f"{r[loop]['steps_per_s']:17.0f} {r[loop]['cpu_steps_per_s']:21.0f} {r[loop]['real_time_factor']:13.2f}")
+        for r in results["backends"].values():
+            row.append(
+                f"{r[loop]['steps_per_s']:17.0f} {r[loop]['cpu_steps_per_s']:21.0f} {r[loop]['real_time_factor']:13.2f}"
+            )
         print(f"{loop:14s} " + " ".join(row))
     if not args.no_ik:
         ik = results["ik"]
-        print(f"IK batched: {ik['targets']} targets in {ik['wall_s']:.2f} s ({ik['ms_per_target']:.2f} ms each), "
-              f"{ik['within_1mm_1deg']:.1%} within 1 mm / 1 deg")
+        print(
+            f"IK batched: {ik['targets']} targets in {ik['wall_s']:.2f} s ({ik['ms_per_target']:.2f} ms each), "
+            f"{ik['within_1mm_1deg']:.1%} within 1 mm / 1 deg"
+        )
         sd = ik["seeded"]
-        print(f"IK seeded: {sd['calls']} single-target calls, {sd['ms_per_call']:.2f} ms each, "
-              f"{sd['within_1mm_1deg']:.1%} within 1 mm / 1 deg (max {sd['max_pos_error_m'] * 1e3:.3g} mm)")
-    print(f"load average {results['machine']['load_avg_1min']:.2f} -> {results['machine']['load_avg_after']:.2f} "
-          f"on {results['machine']['cpu_count']} CPUs")
+        print(
+            f"IK seeded: {sd['calls']} single-target calls, {sd['ms_per_call']:.2f} ms each, "
+            f"{sd['within_1mm_1deg']:.1%} within 1 mm / 1 deg (max {sd['max_pos_error_m'] * 1e3:.3g} mm)"
+        )
+    print(
+        f"load average {results['machine']['load_avg_1min']:.2f} -> {results['machine']['load_avg_after']:.2f} "
+        f"on {results['machine']['cpu_count']} CPUs"
+    )
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(results, fh, indent=2)

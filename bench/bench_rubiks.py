@@ -47,10 +47,18 @@ def run_one(task: str, strategy: str, backend: str, robot: str, seed: int, worke
     sim = sum(float(r.sim_s or 0.0) for r in recs)
     cpu = (cpu1.user - cpu0.user) + (cpu1.children_user - cpu0.children_user)
     return {
-        "task": task, "strategy": strategy, "backend": backend, "robot": robot, "seed": seed, "workers": workers,
-        "trials": len(recs), "successes": sum(r.status.value == "success" for r in recs),
+        "task": task,
+        "strategy": strategy,
+        "backend": backend,
+        "robot": robot,
+        "seed": seed,
+        "workers": workers,
+        "trials": len(recs),
+        "successes": sum(r.status.value == "success" for r in recs),
         "causes": [r.failure_cause.value if r.failure_cause else None for r in recs],
-        "sim_s": round(sim, 2), "wall_s": round(wall, 2), "cpu_user_s": round(cpu, 2),
+        "sim_s": round(sim, 2),
+        "wall_s": round(wall, 2),
+        "cpu_user_s": round(cpu, 2),
         "rtf": round(sim / wall, 2) if wall > 0 else None,
     }
 
@@ -73,10 +81,15 @@ def main(argv: list[str] | None = None) -> int:
         for backend in a.backends.split(","):
             r = run_one(a.task, strategy, backend, a.robot, a.seed, a.workers)
             rows.append(r)
-            print(f"| {r['task']} | {strategy} | {backend} | {r['workers']} | {r['successes']}/{r['trials']} | "
-                  f"{r['sim_s']:.1f} | {r['wall_s']:.1f} | {r['rtf']} | {r['cpu_user_s']:.1f} |", flush=True)
+            print(
+                f"| {r['task']} | {strategy} | {backend} | {r['workers']} | {r['successes']}/{r['trials']} | "
+                f"{r['sim_s']:.1f} | {r['wall_s']:.1f} | {r['rtf']} | {r['cpu_user_s']:.1f} |",
+                flush=True,
+            )
     load = os.getloadavg()
-    print(f"\nload average at the end: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; {os.cpu_count()} CPUs")
+    print(
+        f"\nload average at the end: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; {os.cpu_count()} CPUs"
+    )
     if a.json:
         a.json.write_text(json.dumps(rows, indent=2))
     return 0

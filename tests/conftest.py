@@ -23,9 +23,13 @@ BACKEND_NAMES = ("pybullet", "sapien")
 #: rather than failing on import.
 SIM_MODULES = ("pybullet", "sapien", "torch", "pytorch_kinematics")
 SIM_TESTS = [
-    *(f"{d}{suffix}" for d in ("backends", "robots", "cube_physics", "strategies")
-      for suffix in ("", "/*")),
-    "test_ingrasp*.py", "test_example_plugin.py",
+    *(
+        f"{d}{suffix}"
+        for d in ("backends", "robots", "cube_physics", "strategies")
+        for suffix in ("", "/*")
+    ),
+    "test_ingrasp*.py",
+    "test_example_plugin.py",
 ]
 collect_ignore_glob = (
     SIM_TESTS if any(importlib.util.find_spec(m) is None for m in SIM_MODULES) else []
@@ -33,7 +37,9 @@ collect_ignore_glob = (
 
 
 def pytest_collection_modifyitems(config, items):
-    wanted = {b.strip() for b in os.environ.get("BENCHHARNESS_BACKENDS", "").split(",") if b.strip()}
+    wanted = {
+        b.strip() for b in os.environ.get("BENCHHARNESS_BACKENDS", "").split(",") if b.strip()
+    }
     for item in items:
         parts = set(item.nodeid.replace("\\", "/").split("/"))
         if "backends" in parts or "robots" in parts:
@@ -43,7 +49,9 @@ def pytest_collection_modifyitems(config, items):
         params = getattr(getattr(item, "callspec", None), "params", {})
         used = {v for v in params.values() if isinstance(v, str) and v in BACKEND_NAMES}
         if used and not used <= wanted:
-            item.add_marker(pytest.mark.skip(reason=f"backend not in BENCHHARNESS_BACKENDS={sorted(wanted)}"))
+            item.add_marker(
+                pytest.mark.skip(reason=f"backend not in BENCHHARNESS_BACKENDS={sorted(wanted)}")
+            )
 
 
 @pytest.fixture

@@ -19,14 +19,18 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "benchharness"
 HEAVY = ("pybullet", "sapien", "torch", "matplotlib")
 
 
-@pytest.mark.parametrize("module", ["benchharness.metrics", "benchharness.cli.main", "benchharness.cube"])
+@pytest.mark.parametrize(
+    "module", ["benchharness.metrics", "benchharness.cli.main", "benchharness.cube"]
+)
 def test_import_is_light(module):
     code = (
         f"import sys, {module}\n"
         f"heavy = sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r}))\n"
         "print(','.join(heavy))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.strip()
     assert out == "", f"importing {module} pulled in {out}"
 
 

@@ -66,7 +66,13 @@ def test_net_neighbours_share_a_cubie():
     # Facts about the net, read off a picture of it: U9 touches R1 and F3; U1 touches
     # L1 and B3; D1 touches F7 and L9; D9 touches R9 and B7; F6 and R4 form one edge.
     idx = {n: i for i, n in enumerate(FACELET_NAMES)}
-    groups = [("U9", "R1", "F3"), ("U1", "L1", "B3"), ("D1", "F7", "L9"), ("D9", "R9", "B7"), ("F6", "R4")]
+    groups = [
+        ("U9", "R1", "F3"),
+        ("U1", "L1", "B3"),
+        ("D1", "F7", "L9"),
+        ("D9", "R9", "B7"),
+        ("F6", "R4"),
+    ]
     for group in groups:
         cubies = {tuple(FACELET_CUBIES[idx[n]]) for n in group}
         assert len(cubies) == 1, group
@@ -115,7 +121,9 @@ def test_300_random_sequences_with_slices_and_rotations_match_oracle():
 def test_batched_application_matches_one_by_one():
     rng = np.random.default_rng(3)
     idx = rng.integers(0, len(ALL_MOVES), size=(200, 15))
-    starts = np.stack([apply(SOLVED, random_sequence(random.Random(i), FACE_TOKENS, 10)) for i in range(200)])
+    starts = np.stack(
+        [apply(SOLVED, random_sequence(random.Random(i), FACE_TOKENS, 10)) for i in range(200)]
+    )
     got = apply_batch(starts, idx)
     for i in range(200):
         seq = [ALL_MOVES[j] for j in idx[i]]
@@ -205,7 +213,9 @@ def test_known_orders():
     assert order("R U2 D' B D'") == 1260  # the largest order of any Rubik's cube element
 
 
-@pytest.mark.parametrize("a, b", [("U", "D"), ("R", "L"), ("F", "B"), ("U2", "D'"), ("M", "R"), ("E", "U")])
+@pytest.mark.parametrize(
+    "a, b", [("U", "D"), ("R", "L"), ("F", "B"), ("U2", "D'"), ("M", "R"), ("E", "U")]
+)
 def test_opposite_layers_commute(a, b):
     assert np.array_equal(permutation(f"{a} {b}"), permutation(f"{b} {a}"))
 
@@ -216,13 +226,18 @@ def test_adjacent_faces_do_not_commute():
 
 def test_superflip_flips_every_edge_and_nothing_else():
     superflip = "U R2 F B R B2 R U2 L B2 R U' D' R2 F R' L B2 U2 F2"
-    assert to_string(apply(SOLVED, superflip)) == "UBULURUFURURFRBRDRFUFLFRFDFDFDLDRDBDLULBLFLDLBUBRBLBDB"
+    assert (
+        to_string(apply(SOLVED, superflip))
+        == "UBULURUFURURFRBRDRFUFLFRFDFDFDLDRDBDLULBLFLDLBUBRBLBDB"
+    )
 
 
 def test_permutation_table_is_consistent():
     for m in ALL_MOVES:
         assert sorted(MOVE_PERMUTATIONS[m.index].tolist()) == list(range(54))
-        assert np.array_equal(MOVE_PERMUTATIONS[m.index][MOVE_PERMUTATIONS[m.inverse().index]], IDENTITY)
+        assert np.array_equal(
+            MOVE_PERMUTATIONS[m.index][MOVE_PERMUTATIONS[m.inverse().index]], IDENTITY
+        )
     assert indices(parse_sequence("U R2 x'")).tolist() == [0, 4, 29]
 
 

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from benchharness.cube import format_sequence, generate_sequence, generate_sequences, get_tier, load_tiers
+from benchharness.cube import (
+    format_sequence,
+    generate_sequence,
+    generate_sequences,
+    get_tier,
+    load_tiers,
+)
 from benchharness.cube.prng import SplitMix64, fnv1a_64
 from benchharness.cube.sequences import GENERATED_MOVES, trial_key
 
@@ -173,7 +179,8 @@ def test_count_sequences_by_brute_force():
 
     def ok(seq):
         return all(seq[i][0] != seq[i - 1][0] for i in range(1, len(seq))) and not any(
-            AXIS[seq[i][0]] == AXIS[seq[i - 1][0]] == AXIS[seq[i - 2][0]] for i in range(2, len(seq))
+            AXIS[seq[i][0]] == AXIS[seq[i - 1][0]] == AXIS[seq[i - 2][0]]
+            for i in range(2, len(seq))
         )
 
     tokens = [str(m) for m in GENERATED_MOVES]

@@ -54,7 +54,9 @@ def test_cubie_tables_match_geometry():
     for pos, names in CORNERS.items():
         idx = [FACELET_INDEX[n] for n in names]
         normals = [FACELET_POSITIONS[i] - 2 * FACELET_CUBIES[i] for i in idx]
-        assert np.dot(np.cross(normals[0], normals[1]), normals[2]) < 0, pos  # clockwise from outside
+        assert np.dot(np.cross(normals[0], normals[1]), normals[2]) < 0, (
+            pos
+        )  # clockwise from outside
 
 
 def test_solved_and_scrambled_are_valid():
@@ -85,7 +87,10 @@ def test_wrong_characters():
 
 def test_wrong_counts():
     (reason,) = facelet_problems(edit(SOLVED_STRING, U1="R"))
-    assert reason == "each colour must appear exactly 9 times, but U appears 8 times, R appears 10 times"
+    assert (
+        reason
+        == "each colour must appear exactly 9 times, but U appears 8 times, R appears 10 times"
+    )
 
 
 def test_centres_out_of_order():
@@ -124,9 +129,12 @@ def test_swapped_pair_of_edges():
 
 
 def test_swapped_pair_of_corners():
-    s = swap(SOLVED_STRING, ("U9", "U7"), ("R1", "F1"), ("F3", "L3"))  # URF <-> UFL, orientation kept
-    assert "permutation parity: the corner permutation is odd but the edge permutation is even" in (
-        facelet_problems(s)[0]
+    s = swap(
+        SOLVED_STRING, ("U9", "U7"), ("R1", "F1"), ("F3", "L3")
+    )  # URF <-> UFL, orientation kept
+    assert (
+        "permutation parity: the corner permutation is odd but the edge permutation is even"
+        in (facelet_problems(s)[0])
     )
 
 
@@ -145,7 +153,10 @@ def test_impossible_corner_colours():
 
 def test_mirrored_corner_is_no_corner():
     s = swap(SOLVED_STRING, ("R1", "F3"))  # U-F-R order: a mirror image of the URF cubie
-    assert facelet_problems(s)[0] == "corner URF (U9/R1/F3) shows U-F-R, which is no corner of the cube"
+    assert (
+        facelet_problems(s)[0]
+        == "corner URF (U9/R1/F3) shows U-F-R, which is no corner of the cube"
+    )
 
 
 def test_duplicated_cubie():
@@ -161,7 +172,9 @@ def test_duplicated_cubie():
 def test_check_facelets_raises_with_reasons():
     with pytest.raises(FaceletError) as info:
         check_facelets("U" * 54, "initial state")
-    assert str(info.value).startswith("invalid initial state: each colour must appear exactly 9 times")
+    assert str(info.value).startswith(
+        "invalid initial state: each colour must appear exactly 9 times"
+    )
     assert len(info.value.reasons) == 2
 
 

@@ -183,7 +183,9 @@ def test_registration_is_cheap_and_builds_a_planner():
     assert reg.name == "dmg"
     assert isinstance(reg.factory(), DMGPlanner)
     code = "import sys, benchharness.strategies.dmg; print('networkx' in sys.modules, 'trimesh' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.split()
     assert out == ["False", "False"]
 
 

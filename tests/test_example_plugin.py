@@ -25,9 +25,20 @@ def installed(tmp_path_factory):
     target = tmp_path_factory.mktemp("site")
     build = tmp_path_factory.mktemp("build")
     subprocess.run(
-        [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation",
-         "--target", str(target), str(EXAMPLE)],
-        check=True, cwd=build,
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--no-deps",
+            "--no-build-isolation",
+            "--target",
+            str(target),
+            str(EXAMPLE),
+        ],
+        check=True,
+        cwd=build,
     )
     env = dict(os.environ, PYTHONPATH=str(target))
     return env
@@ -48,8 +59,13 @@ def test_items_appear_with_the_example_distribution(installed):
 
 
 def test_not_visible_without_installing():
-    out = subprocess.run([*CLI, "plugins", "--json"], capture_output=True, text=True, timeout=300,
-                         env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
+    out = subprocess.run(
+        [*CLI, "plugins", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
+    )
     names = {i["name"] for i in json.loads(out.stdout)["items"]}
     assert "example-gantry-gripper" not in names
 
@@ -79,7 +95,9 @@ grasp = grip.close(obj=cube)
 arm.move_to_pose(Pose(np.array([0.1, 0.05, 0.15])))
 print(reach.pos_error, grasp.contact, b.get_pose(cube).p[2])
 """
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=installed, timeout=300)
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=installed, timeout=300
+    )
     assert out.returncode == 0, out.stderr
     pos_error, contact, z = out.stdout.split()
     assert float(pos_error) < 0.005

@@ -16,7 +16,12 @@ import pytest
 import trimesh
 from scipy.spatial.distance import pdist
 
-from benchharness.metrics.contact import ObjectSurface, contact_region_error, euclidean_max_min, object_surface
+from benchharness.metrics.contact import (
+    ObjectSurface,
+    contact_region_error,
+    euclidean_max_min,
+    object_surface,
+)
 
 A = 0.05
 HEAT_REL_TOL = 0.03  # heat method on a ~4k-vertex mesh: observed 0.4-1.2 %
@@ -28,7 +33,12 @@ def grid_box(a=A, n=20):
     uu, vv = (g.ravel() for g in np.meshgrid(u, u, indexing="ij"))
     k = np.arange(n + 1)
     i, j = (g.ravel() for g in np.meshgrid(k[:-1], k[:-1], indexing="ij"))
-    q00, q10, q01, q11 = i * (n + 1) + j, (i + 1) * (n + 1) + j, i * (n + 1) + j + 1, (i + 1) * (n + 1) + j + 1
+    q00, q10, q01, q11 = (
+        i * (n + 1) + j,
+        (i + 1) * (n + 1) + j,
+        i * (n + 1) + j + 1,
+        (i + 1) * (n + 1) + j + 1,
+    )
     tri = np.vstack([np.column_stack([q00, q10, q11]), np.column_stack([q00, q11, q01])])
     verts, faces = [], []
     for axis in range(3):

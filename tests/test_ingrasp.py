@@ -35,8 +35,13 @@ def test_fast_fk_matches_pytorch_kinematics(hand):
 
 def test_fk_gradient_matches_finite_differences(hand):
     """Autograd through the fingertip FK agrees with central differences (per joint, all fingers)."""
-    q = torch.tensor([0.1, 0.4, 0.9, 0.7, -0.1, 0.5, 0.8, 0.6, 0.0, 0.3, 0.3, 0.3, 1.0, 0.4, 0.6, 0.9], dtype=DTYPE)
-    w = torch.randn(4, 4, 4, generator=torch.Generator().manual_seed(1), dtype=DTYPE)  # random linear functional
+    q = torch.tensor(
+        [0.1, 0.4, 0.9, 0.7, -0.1, 0.5, 0.8, 0.6, 0.0, 0.3, 0.3, 0.3, 1.0, 0.4, 0.6, 0.9],
+        dtype=DTYPE,
+    )
+    w = torch.randn(
+        4, 4, 4, generator=torch.Generator().manual_seed(1), dtype=DTYPE
+    )  # random linear functional
 
     def f(x):
         return (hand.tip_poses(x[None], FINGERS)[0] * w).sum()
@@ -69,12 +74,16 @@ def _synthetic(hand, tasks, delta):
     lo, hi = hand.limits(base.fingers)
     q_goal = np.clip(base.q0 + delta, lo, hi)
     with torch.no_grad():
-        goal = object_poses(hand, base, torch.as_tensor(q_goal[None], dtype=DTYPE), "fingertips")[0].numpy()
+        goal = object_poses(hand, base, torch.as_tensor(q_goal[None], dtype=DTYPE), "fingertips")[
+            0
+        ].numpy()
     return replace(base, goal=goal), q_goal
 
 
 def test_relaxed_rigidity_reaches_a_reachable_goal(hand, tasks):
-    delta = np.array([0.1, -0.3, 0.3, 0.1, 0.1, -0.3, 0.3, 0.1, 0.0, -0.2, 0.2, -0.2])  # 1.7 cm, 11 deg
+    delta = np.array(
+        [0.1, -0.3, 0.3, 0.1, 0.1, -0.3, 0.3, 0.1, 0.0, -0.2, 0.2, -0.2]
+    )  # 1.7 cm, 11 deg
     prob, _ = _synthetic(hand, tasks, delta)
     moved = np.linalg.norm(prob.goal[:3, 3] - prob.object_initial[:3, 3])
     assert moved > 0.01  # a real motion, not a no-op
@@ -147,10 +156,16 @@ def test_results_file_round_trips_through_score_cli(hand, tasks, tmp_path):
     groups = {g["key"]["method"]: g for g in data["groups"]}
     assert set(groups) == {"relaxed-rigidity", "ik-rigid"} and data["n_trials"] == 4
     for v, g in groups.items():
-        mine = [err_pos(t.desired[:3], p.reached[:3]) * 100 for t, p in zip(rows, plans) if p.variant == v]
+        mine = [
+            err_pos(t.desired[:3], p.reached[:3]) * 100
+            for t, p in zip(rows, plans)
+            if p.variant == v
+        ]
         assert g["metrics"]["err_pos"]["median"] == pytest.approx(np.median(mine), rel=1e-9)
         # the planned error the optimiser reports is the one the file scores
-        assert np.median([p.pos_error for p in plans if p.variant == v]) * 100 == pytest.approx(np.median(mine), rel=1e-6)
+        assert np.median([p.pos_error for p in plans if p.variant == v]) * 100 == pytest.approx(
+            np.median(mine), rel=1e-6
+        )
         assert g["metrics"]["plan_time_s"]["n"] == 2
 
 

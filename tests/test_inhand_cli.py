@@ -66,30 +66,76 @@ def _box_mesh(path):
 
 def test_setup_rule_discarded_and_contacts(tmp_path):
     _box_mesh(tmp_path / "box.stl")
-    head = ["method", "object", "task_id", "trial", "level", "dropped", "plan_time_s", "exec_time_s"]
+    head = [
+        "method",
+        "object",
+        "task_id",
+        "trial",
+        "level",
+        "dropped",
+        "plan_time_s",
+        "exec_time_s",
+    ]
     for s in ("initial", "desired", "setup", "reached"):
         head += [f"{s}_{f}" for f in ("x", "y", "z", "qx", "qy", "qz", "qw")]
-    head += ["desired_contact1_x", "desired_contact1_y", "desired_contact1_z",
-             "reached_contact1_x", "reached_contact1_y", "reached_contact1_z", "object_mesh"]
+    head += [
+        "desired_contact1_x",
+        "desired_contact1_y",
+        "desired_contact1_z",
+        "reached_contact1_x",
+        "reached_contact1_y",
+        "reached_contact1_z",
+        "object_mesh",
+    ]
     q = ["0", "0", "0", "1"]
 
     def row(trial, setup_x, dropped=0):
         return [
-            "M", "box", "t1", str(trial), "3", str(dropped), "0.1", "2.0",
-            "0", "0", "0", *q, "0.1", "0", "0", *q, str(setup_x), "0", "0", *q,
+            "M",
+            "box",
+            "t1",
+            str(trial),
+            "3",
+            str(dropped),
+            "0.1",
+            "2.0",
+            "0",
+            "0",
+            "0",
+            *q,
+            "0.1",
+            "0",
+            "0",
+            *q,
+            str(setup_x),
+            "0",
+            "0",
+            *q,
             *(["0.09", "0", "0", *q] if not dropped else [""] * 7),
             # desired contact at a top corner, reached at the adjacent corner: 10 cm along an edge
-            "0.05", "0.05", "0.05", "-0.05", "0.05", "0.05", "box.stl",
+            "0.05",
+            "0.05",
+            "0.05",
+            "-0.05",
+            "0.05",
+            "0.05",
+            "box.stl",
         ]
 
     rows = [row(1, 0.0), row(2, 0.02), row(3, 0.0, dropped=1), row(4, 0.005)]
     p = tmp_path / "res.csv"
     p.write_text("\n".join(",".join(r) for r in [head, *rows]) + "\n")
-    r = run("score", p, "--discarded", "--json", "--geodesic", "exact")  # heat is coarse on 8 vertices
+    r = run(
+        "score", p, "--discarded", "--json", "--geodesic", "exact"
+    )  # heat is coarse on 8 vertices
     assert r.exit_code == 0, r.output
     data = json.loads(r.output)
     (g,) = data["groups"]
-    assert g["n_discarded"] == 1 and g["n_trials"] == 3 and g["drops_percent"] == pytest.approx(100 / 3)
+    assert (
+        g["n_discarded"] == 1
+        and g["n_trials"] == 3
+        and g["drops_percent"] == pytest.approx(100 / 3)
+    )
     assert [d["trial"] for d in data["discarded"]] == [2]
     assert data["discarded"][0]["setup_err_pos_percent"] == pytest.approx(20.0)
     assert g["metrics"]["g_euc"]["median"] == pytest.approx(10.0)

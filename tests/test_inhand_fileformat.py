@@ -78,9 +78,16 @@ def test_missing_column(tmp_path):
 
 def test_json_results(tmp_path):
     trial = {
-        "method": "A", "object": "apple", "task_id": "t1", "trial": 1, "level": 3, "dropped": False,
-        "plan_time_s": 0.2, "exec_time_s": None,
-        "initial": [0, 0, 0, 0, 0, 0, 1], "desired": [0.1, 0, 0, 0, 0, 0, 1],
+        "method": "A",
+        "object": "apple",
+        "task_id": "t1",
+        "trial": 1,
+        "level": 3,
+        "dropped": False,
+        "plan_time_s": 0.2,
+        "exec_time_s": None,
+        "initial": [0, 0, 0, 0, 0, 0, 1],
+        "desired": [0.1, 0, 0, 0, 0, 0, 1],
         "reached": [0.09, 0, 0, 0, 0, 0, 1],
         "contacts": {"reached": [[0, 0, 0], [1, 1, 1]], "desired": [[0, 0, 0]]},
         "extra": {"robot": "yumi"},
@@ -97,8 +104,9 @@ def test_json_results(tmp_path):
 
 def test_task_file(tmp_path):
     p = tmp_path / "t.csv"
-    cols = "task_id,object,level," + ",".join(f"{s}_{f}" for s in ("initial", "desired")
-                                               for f in ("x", "y", "z", "qx", "qy", "qz", "qw"))
+    cols = "task_id,object,level," + ",".join(
+        f"{s}_{f}" for s in ("initial", "desired") for f in ("x", "y", "z", "qx", "qy", "qz", "qw")
+    )
     p.write_text(cols + "\nt1,apple,1,0,0,0,0,0,0,1,0.1,0,0,0,0,0,1\n")
     t = read_tasks(p)
     assert t.task_id.tolist() == ["t1"] and t.desired[0, 0] == 0.1

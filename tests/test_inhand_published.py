@@ -14,7 +14,9 @@ from benchharness.metrics.pose import err_or_percent
 REPO = Path(__file__).resolve().parents[1]
 TASKS = REPO / "tasks" / "inhand"
 SOURCE = REPO.parent / "shared" / "data" / "bih_dataset"
-needs_source = pytest.mark.skipif(not SOURCE.is_dir(), reason=f"published dataset not found at {SOURCE}")
+needs_source = pytest.mark.skipif(
+    not SOURCE.is_dir(), reason=f"published dataset not found at {SOURCE}"
+)
 
 # Paper, Table III (DMG, YuMi, Level III): err_pos (cm), err_pos %, err_or %
 TABLE_III = {
@@ -30,7 +32,10 @@ DIGITS = (3, 1, 3)
 def dmg():
     r = read_results(TASKS / "published" / "yumi_lvl3_dmg.csv")
     s = score_trials(r.initial, r.desired, r.reached, dropped=r.dropped)
-    return {o: (s.err_pos[i] * 100, s.err_pos_percent[i], s.err_or_percent[i]) for i, o in enumerate(r.object)}
+    return {
+        o: (s.err_pos[i] * 100, s.err_pos_percent[i], s.err_or_percent[i])
+        for i, o in enumerate(r.object)
+    }
 
 
 def printed_as(value, paper, digits, slack=0.5):
@@ -48,7 +53,10 @@ POTTED_POS = pytest.mark.xfail(
 @pytest.mark.parametrize(
     "obj, k",
     [(o, k) for o in TABLE_III for k in range(3) if not (o == "potted meat can" and k < 2)]
-    + [pytest.param("potted meat can", 0, marks=POTTED_POS), pytest.param("potted meat can", 1, marks=POTTED_POS)],
+    + [
+        pytest.param("potted meat can", 0, marks=POTTED_POS),
+        pytest.param("potted meat can", 1, marks=POTTED_POS),
+    ],
 )
 def test_table_iii(dmg, obj, k):
     value, paper = dmg[obj][k], TABLE_III[obj][k]
@@ -114,8 +122,13 @@ def module_allegro_medians():
     s = score_trials(r.initial, r.desired, r.reached, dropped=r.dropped)
     groups = summarize_scores(s, {"object": r.object}, ["object"], r.dropped)
     return {
-        g.key[0]: np.array([g.stats["err_pos"].median * 100, g.stats["err_pos_percent"].median,
-                            g.stats["err_or_percent"].median])
+        g.key[0]: np.array(
+            [
+                g.stats["err_pos"].median * 100,
+                g.stats["err_pos_percent"].median,
+                g.stats["err_or_percent"].median,
+            ]
+        )
         for g in groups
     }
 
@@ -149,7 +162,9 @@ def test_committed_files_equal_fresh_conversion(tmp_path):
     convert_bih(SOURCE, tmp_path)
     for name in OUTPUT_FILES:
         fresh, committed = (tmp_path / name).read_bytes(), (TASKS / name).read_bytes()
-        assert fresh == committed, f"tasks/inhand/{name} differs from a fresh conversion: re-run import-bih"
+        assert fresh == committed, (
+            f"tasks/inhand/{name} differs from a fresh conversion: re-run import-bih"
+        )
 
 
 def test_hand_pose_task_set_marks_dmg_rows():

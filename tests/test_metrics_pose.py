@@ -45,7 +45,9 @@ def test_err_or_percent_for_rotation_about_axis(theta, axis):
 def test_err_or_percent_vectorised_and_half_turn_is_100():
     q_d = np.tile([0, 0, 0, 1.0], (3, 1))
     q_r = Rotation.from_rotvec([[np.pi, 0, 0], [0, 0, 0], [0, 0, -np.pi / 2]]).as_quat()
-    np.testing.assert_allclose(err_or_percent(q_d, q_r), [100.0, 0.0, expected_or_percent(np.pi / 2)], atol=1e-9)
+    np.testing.assert_allclose(
+        err_or_percent(q_d, q_r), [100.0, 0.0, expected_or_percent(np.pi / 2)], atol=1e-9
+    )
 
 
 def test_normalisation_is_a_choice():

@@ -38,8 +38,14 @@ def test_summarize_groups_drops_and_discards():
     err = np.array([1.0, 2.0, 3.0, 99.0, 50.0])
     dropped = np.array([False, False, False, True, False])
     discarded = np.array([False, False, False, False, True])
-    (g,) = summarize_groups(cols, ["method"], {"err": err, "t": err}, dropped=dropped,
-                            discarded=discarded, error_metrics=["err"])
+    (g,) = summarize_groups(
+        cols,
+        ["method"],
+        {"err": err, "t": err},
+        dropped=dropped,
+        discarded=discarded,
+        error_metrics=["err"],
+    )
     assert (g.n_trials, g.n_dropped, g.n_discarded) == (4, 1, 1)
     assert g.drops_percent == 25.0
     assert g.stats["err"].median == 2.0  # dropped and discarded excluded
@@ -63,8 +69,12 @@ def test_plot_whiskers_match_hand_computation(tmp_path):
 
 
 def test_plot_svg(tmp_path):
-    summ = summarize_groups({"object": ["o"] * 3, "method": ["A"] * 3}, ["object", "method"],
-                            {"err": np.array([1.0, 2.0, 3.0])}, dropped=np.zeros(3, bool))
+    summ = summarize_groups(
+        {"object": ["o"] * 3, "method": ["A"] * 3},
+        ["object", "method"],
+        {"err": np.array([1.0, 2.0, 3.0])},
+        dropped=np.zeros(3, bool),
+    )
     out = tmp_path / "box.svg"
     box_plot(summ, ["err"], out)
     assert out.read_text().lstrip().startswith("<?xml")

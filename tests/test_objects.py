@@ -129,7 +129,14 @@ def test_cylinder_mesh_volume_and_area():
     assert m.area == pytest.approx(2 * np.pi * r**2 + 2 * np.pi * r * length, rel=0.01)
 
 
-@pytest.mark.parametrize("name, size", [("cracker box", (0.06, 0.158, 0.21)), ("gelatin box", (0.028, 0.085, 0.073)), ("potted meat can", (0.05, 0.097, 0.082))])
+@pytest.mark.parametrize(
+    "name, size",
+    [
+        ("cracker box", (0.06, 0.158, 0.21)),
+        ("gelatin box", (0.028, 0.085, 0.073)),
+        ("potted meat can", (0.05, 0.097, 0.082)),
+    ],
+)
 def test_box_mesh_volume_and_area_are_exact(name, size):
     a, b, c = size
     m = load_object(name).surface
@@ -141,7 +148,9 @@ def test_box_union_volume_is_the_sum_of_its_boxes():
     for spec in CATALOG:
         if isinstance(spec.geometry, BoxGeometry):
             m = load_object(spec.name).surface
-            assert m.volume == pytest.approx(sum(b.volume for b in spec.geometry.boxes), rel=1e-9), spec.name
+            assert m.volume == pytest.approx(
+                sum(b.volume for b in spec.geometry.boxes), rel=1e-9
+            ), spec.name
 
 
 def test_sweep_mesh_volume_matches_its_profile_integral():
@@ -232,7 +241,10 @@ def test_cylinder_mass_properties():
 def test_composition_uses_poses_and_parallel_axes():
     # two 1 x 1 x 1 boxes side by side along x are one 2 x 1 x 1 box, here offset and rotated
     off = np.array([0.3, -0.2, 0.5])
-    two = [Box((0.5, 0.5, 0.5), Pose(off + [-0.5, 0, 0])), Box((0.5, 0.5, 0.5), Pose(off + [0.5, 0, 0]))]
+    two = [
+        Box((0.5, 0.5, 0.5), Pose(off + [-0.5, 0, 0])),
+        Box((0.5, 0.5, 0.5), Pose(off + [0.5, 0, 0])),
+    ]
     one = [Box((1.0, 0.5, 0.5), Pose(off))]
     a, b = mass_properties(two, 2.0), mass_properties(one, 2.0)
     assert np.allclose(a.com, off) and np.allclose(a.inertia, b.inertia)
@@ -242,9 +254,16 @@ def test_composition_uses_poses_and_parallel_axes():
     c = mass_properties([MeshShape(box.vertices + off, box.faces)], 2.0)
     assert np.allclose(c.com, off) and np.allclose(c.inertia, b.inertia)
     # a rotated cylinder: axis along x after a quarter turn about y
-    rot = Pose.from_rotation([0, 0, 0], __import__("scipy.spatial.transform", fromlist=["Rotation"]).Rotation.from_euler("y", 90, degrees=True))
+    rot = Pose.from_rotation(
+        [0, 0, 0],
+        __import__("scipy.spatial.transform", fromlist=["Rotation"]).Rotation.from_euler(
+            "y", 90, degrees=True
+        ),
+    )
     cyl = mass_properties([Cylinder(0.1, 0.5, rot)], 1.0)
-    assert cyl.inertia[0, 0] == pytest.approx(0.1**2 / 2) and cyl.inertia[2, 2] == pytest.approx((3 * 0.01 + 1.0) / 12)
+    assert cyl.inertia[0, 0] == pytest.approx(0.1**2 / 2) and cyl.inertia[2, 2] == pytest.approx(
+        (3 * 0.01 + 1.0) / 12
+    )
 
 
 # ---------------------------------------------------------------------------- substitution by a real mesh
@@ -266,7 +285,9 @@ def test_user_mesh_replaces_surface_and_collision_keeping_the_mass(tmp_path):
     assert m.mass.mass == pytest.approx(0.411)
     assert np.allclose(m.mass.com, shift)
     a, b, c = size
-    assert np.allclose(m.mass.inertia, 0.411 / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b]))
+    assert np.allclose(
+        m.mass.inertia, 0.411 / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
+    )
 
 
 def test_user_mesh_collision_hull_of_a_nonconvex_mesh(tmp_path):

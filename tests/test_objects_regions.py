@@ -30,7 +30,9 @@ def orange():
 @pytest.mark.parametrize("metric, tol", [("euclidean", 0.05), ("geodesic", 0.10)])
 @pytest.mark.parametrize("radius", [0.015, 0.03])
 def test_disc_on_a_flat_face_has_area_pi_r2(box, metric, tol, radius):
-    reg = contact_region(box, [0.08, 0.01, -0.02], radius, metric)  # projects onto the x = +30 mm face
+    reg = contact_region(
+        box, [0.08, 0.01, -0.02], radius, metric
+    )  # projects onto the x = +30 mm face
     assert np.allclose(reg.centre, [0.03, 0.01, -0.02])
     assert reg.area == pytest.approx(np.pi * radius**2, rel=tol)
     v = box.vertices[reg.vertices]

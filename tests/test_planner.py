@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from benchharness.cube import SOLVED, apply, generate_sequences, parse_sequence, reorient
+from benchharness.cube import SOLVED, apply, generate_sequences, reorient
 from benchharness.strategies.regrasp import (
     INITIAL_ORIENTATION,
     HandModel,
@@ -63,6 +63,7 @@ def _face_changes(seq) -> tuple[int, int]:
 
 # --- the logical result -------------------------------------------------------------------------
 
+
 def test_random_sequences_reproduce_the_core_state(planned):
     model, rows = planned
     for seq, _, naive, run in rows:
@@ -80,7 +81,9 @@ def test_every_twist_has_the_rotator_on_its_slab_and_the_holder_on_the_other_two
             assert t.rotator_slabs == {t.layer}
             assert t.holder_slabs == {0, 1, 2} - {t.layer}
             assert t.rotator_axis == t.holder_axis == t.axis
-        assert run.moves == [str(m) for m in seq]  # each twist is the prescribed face move, in order
+        assert run.moves == [
+            str(m) for m in seq
+        ]  # each twist is the prescribed face move, in order
 
 
 def test_slices_and_rotations_match_the_core_after_reorienting():
@@ -91,7 +94,9 @@ def test_slices_and_rotations_match_the_core_after_reorienting():
         assert np.array_equal(execute(plan_sequence(token)).state, want), token
     seq = "x U M' y R S2 z' E F x2 B' M2"
     for model in MODELS.values():
-        assert np.array_equal(execute(plan_sequence(seq, model)).state, reorient(apply(SOLVED, seq)))
+        assert np.array_equal(
+            execute(plan_sequence(seq, model)).state, reorient(apply(SOLVED, seq))
+        )
 
 
 def test_a_rotation_changes_which_face_a_letter_names():
@@ -100,6 +105,7 @@ def test_a_rotation_changes_which_face_a_letter_names():
 
 
 # --- regrasp counts -----------------------------------------------------------------------------
+
 
 def test_regrasps_meet_the_lower_bound_and_beat_naive(planned):
     """Under Fig. 2's rule one grasp can turn only one face, so every change of face costs at least one
@@ -121,9 +127,13 @@ def test_mean_regrasps_per_move_over_the_random_set(planned):
     mean = sum(p.total_regrasps for _, p, *_ in rows) / moves
     naive = sum(n.total_regrasps for _, _, n, _ in rows) / moves
     handovers = sum(p.handovers for _, p, *_ in rows) / moves
-    print(f"\n{model.name}: {mean:.4f} regrasps/move ({handovers:.4f} hand-overs), naive {naive:.4f}, "
-          f"mean cost {np.mean([p.cost for _, p, *_ in rows]):.1f} vs naive {np.mean([n.cost for _, _, n, _ in rows]):.1f}")
-    assert mean == pytest.approx(19 / 20)  # generated sequences never repeat a face: 19 face changes
+    print(
+        f"\n{model.name}: {mean:.4f} regrasps/move ({handovers:.4f} hand-overs), naive {naive:.4f}, "
+        f"mean cost {np.mean([p.cost for _, p, *_ in rows]):.1f} vs naive {np.mean([n.cost for _, _, n, _ in rows]):.1f}"
+    )
+    assert mean == pytest.approx(
+        19 / 20
+    )  # generated sequences never repeat a face: 19 face changes
     assert naive == 1.0
 
 
@@ -163,11 +173,16 @@ def test_limited_wrist_unwinds_only_when_it_must():
 
 # --- optimality against an independent uniform-cost search ---------------------------------------
 
+
 def _brute_force_cost(moves: str, model: HandModel) -> int:
     """Dijkstra without a heuristic over (twists done, cube orientation, rotator, roll), written here from
     the rules in docs/planner.md; slices offer both orders. Shares only the translation and geometry."""
     c = model.costs
-    rolls = [0] if model.wrist_roll_limit is None else list(range(-model.wrist_roll_limit, model.wrist_roll_limit + 1))
+    rolls = (
+        [0]
+        if model.wrist_roll_limit is None
+        else list(range(-model.wrist_roll_limit, model.wrist_roll_limit + 1))
+    )
     lim = model.wrist_roll_limit
     programs = [[]]
     for mt in logical_twists(moves):
@@ -175,8 +190,8 @@ def _brute_force_cost(moves: str, model: HandModel) -> int:
     best = None
     for prog in programs:
         heap, seen, k = [], set(), 0
-        for g, where in [("left", "+y"), ("right", "-y")]:
-            for approach, d in (("side", where), ("top", "+z"), ("front", "-x")):
+        for _g, where in [("left", "+y"), ("right", "-y")]:
+            for _approach, d in (("side", where), ("top", "+z"), ("front", "-x")):
                 o = INITIAL_ORIENTATION
                 extra = 0
                 if d != where:
@@ -211,7 +226,9 @@ def _brute_force_cost(moves: str, model: HandModel) -> int:
                 if lim is not None:
                     nxt.append((cost + c.unwind, i, m, rot, r2))
                 # the holder gives; it may end on the robot's side (-x) or above (+z) only
-                for axis, q in {"left": [("z", 1), ("x", 1)], "right": [("z", -1), ("x", -1)]}[other]:
+                for axis, q in {"left": [("z", 1), ("x", 1)], "right": [("z", -1), ("x", -1)]}[
+                    other
+                ]:
                     if True:
                         for rot2 in ("left", "right"):
                             nxt.append((cost + c.handover, i, o.rotated(axis, q).matrix, rot2, r2))
@@ -240,30 +257,41 @@ def test_cost_is_optimal_against_brute_force_on_short_sequences(name):
 
 # --- the plan object ----------------------------------------------------------------------------
 
+
 def test_plan_shape_counts_and_determinism():
     seq = "R U R' U' F2 D L' B M y S'"
     a, b = plan_sequence(seq), plan_sequence(seq)
     assert a == b
     assert isinstance(a.actions[0], Pick) and isinstance(a.actions[-1], Release)
-    assert a.twists == sum(isinstance(x, Twist) for x in a.actions) == 12  # M and S' are two twists each
+    assert (
+        a.twists == sum(isinstance(x, Twist) for x in a.actions) == 12
+    )  # M and S' are two twists each
     assert a.regrasps + a.handovers == a.total_regrasps
     assert a.reclamps == 2 * a.regrasps + 2 * a.handovers
 
 
 def test_plan_is_the_same_under_another_hash_seed():
-    code = ("from benchharness.strategies.regrasp import plan_sequence;"
-            "print(plan_sequence(\"R U R' U' F2 D L' B M y S'\").describe())")
+    code = (
+        "from benchharness.strategies.regrasp import plan_sequence;"
+        "print(plan_sequence(\"R U R' U' F2 D L' B M y S'\").describe())"
+    )
     outs = []
     for seed in ("1", "2"):
         env = {**os.environ, "PYTHONHASHSEED": seed}
-        outs.append(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout)
+        outs.append(
+            subprocess.run(
+                [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+            ).stdout
+        )
     assert outs[0] == outs[1] == plan_sequence("R U R' U' F2 D L' B M y S'").describe() + "\n"
 
 
 def test_describe_lists_every_action_and_the_counts():
     plan = plan_sequence("U R D'")
     text = plan.describe()
-    assert "3 twists, 1 regrasps, 1 hand-overs" in text or "3 twists, 0 regrasps, 2 hand-overs" in text
+    assert (
+        "3 twists, 1 regrasps, 1 hand-overs" in text or "3 twists, 0 regrasps, 2 hand-overs" in text
+    )
     assert text.count("twist     ") == 3
     assert "[move 3: D']" in text
     assert "release" in text.splitlines()[-1]
@@ -280,10 +308,16 @@ def test_body_frame_is_the_physical_cubes():
 
 def test_initial_orientation_is_u_up_f_towards_the_robot():
     o = INITIAL_ORIENTATION
-    assert (o.face_along("+z"), o.face_along("-x"), o.face_along("-y"), o.face_along("+y")) == ("U", "F", "R", "L")
+    assert (o.face_along("+z"), o.face_along("-x"), o.face_along("-y"), o.face_along("+y")) == (
+        "U",
+        "F",
+        "R",
+        "L",
+    )
 
 
 # --- the executor refuses broken plans (so the tests above can fail) ------------------------------
+
 
 def _swap(plan, index, action):
     acts = list(plan.actions)
@@ -299,8 +333,18 @@ def _first(plan, cls):
     "mutate, message",
     [
         (lambda p, i: _swap(p, i, replace(p.actions[i], layer=1)), "only turn slab"),
-        (lambda p, i: _swap(p, i, replace(p.actions[i], gripper="right" if p.actions[i].gripper == "left" else "left",
-                                          layer=2 - p.actions[i].layer)), "touches slabs"),
+        (
+            lambda p, i: _swap(
+                p,
+                i,
+                replace(
+                    p.actions[i],
+                    gripper="right" if p.actions[i].gripper == "left" else "left",
+                    layer=2 - p.actions[i].layer,
+                ),
+            ),
+            "touches slabs",
+        ),
         (lambda p, i: _swap(p, i, replace(p.actions[i], axis="z")), "work axis"),
         (lambda p, i: _swap(p, i, replace(p.actions[i], face="B")), "plan says"),
         (lambda p, i: replace(p, actions=p.actions[1:]), "still on the table"),
@@ -317,7 +361,9 @@ def test_executor_rejects_broken_twists(mutate, message):
 def test_a_flipped_twist_without_annotation_gives_a_different_state():
     plan = plan_sequence("U R F")
     i = _first(plan, Twist)
-    bad = _swap(plan, i, replace(plan.actions[i], quarter_turns=-plan.actions[i].quarter_turns, face=""))
+    bad = _swap(
+        plan, i, replace(plan.actions[i], quarter_turns=-plan.actions[i].quarter_turns, face="")
+    )
     assert not np.array_equal(execute(bad).state, apply(SOLVED, "U R F"))
 
 
@@ -327,14 +373,29 @@ def test_executor_rejects_bad_handovers_picks_and_wrist_overruns():
     with pytest.raises(PlanError, match="quarter turn about x or z"):
         execute(_swap(plan, i, replace(plan.actions[i], quarter_turns=2)))
     with pytest.raises(PlanError, match="would leave the"):
-        execute(_swap(plan, i, replace(plan.actions[i], quarter_turns=-plan.actions[i].quarter_turns)))
+        execute(
+            _swap(plan, i, replace(plan.actions[i], quarter_turns=-plan.actions[i].quarter_turns))
+        )
     with pytest.raises(PlanError, match="gives"):
-        execute(_swap(plan, i, replace(plan.actions[i], giver=plan.actions[i].taker, taker=plan.actions[i].giver)))
+        execute(
+            _swap(
+                plan,
+                i,
+                replace(plan.actions[i], giver=plan.actions[i].taker, taker=plan.actions[i].giver),
+            )
+        )
     with pytest.raises(PlanError, match="on the table is"):
         execute(_swap(plan, 0, replace(plan.actions[0], face="D")))
     herb = plan_sequence("U U", HandModel.herb())
     with pytest.raises(PlanError, match="beyond"):
-        execute(_swap(herb, 0, replace(herb.actions[0], roll=0)) if herb.actions[0].roll else
-                _swap(herb, 0, replace(herb.actions[0], roll=-1 if herb.actions[1].quarter_turns < 0 else 1)))
+        execute(
+            _swap(herb, 0, replace(herb.actions[0], roll=0))
+            if herb.actions[0].roll
+            else _swap(
+                herb,
+                0,
+                replace(herb.actions[0], roll=-1 if herb.actions[1].quarter_turns < 0 else 1),
+            )
+        )
     with pytest.raises(PlanError, match="not available"):
         execute(plan, model=HandModel(pick_approaches=("side",)))

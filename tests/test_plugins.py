@@ -22,7 +22,9 @@ from benchharness.plugin import (
 )
 
 
-def make_distribution(root: Path, dist: str, entry_points: dict[str, str], modules: dict[str, str]) -> None:
+def make_distribution(
+    root: Path, dist: str, entry_points: dict[str, str], modules: dict[str, str]
+) -> None:
     """Write an installed-looking distribution (dist-info + modules) under ``root``."""
     info = root / f"{dist.replace('-', '_')}-0.1.dist-info"
     info.mkdir(parents=True)
@@ -64,7 +66,9 @@ def test_builtins_come_through_entry_points():
 
 
 def test_third_party_items_appear_with_their_distribution(site):
-    make_distribution(site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD})
+    make_distribution(
+        site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD}
+    )
     m = PluginManager()
     m.load_entry_points()
     arm = m.get("robot", "thirdparty-arm")
@@ -75,7 +79,9 @@ def test_third_party_items_appear_with_their_distribution(site):
 
 
 def test_import_failure_is_isolated_and_named(site):
-    make_distribution(site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD})
+    make_distribution(
+        site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD}
+    )
     make_distribution(
         site,
         "thirdparty-broken",
@@ -120,7 +126,9 @@ from benchharness.plugin import Registration, hookimpl
 def benchharness_tasks():
     return [Registration({name!r}, lambda: "impostor")]
 """
-    make_distribution(site, "aaa-shadow", {"shadow": "thirdparty_shadow"}, {"thirdparty_shadow": src})
+    make_distribution(
+        site, "aaa-shadow", {"shadow": "thirdparty_shadow"}, {"thirdparty_shadow": src}
+    )
     m = PluginManager()
     m.load_entry_points()
     assert m.get("task", name).distribution == "benchharness"
@@ -157,7 +165,12 @@ def test_wrong_return_type_is_reported():
 
 
 def test_not_found_error_lists_available_and_failures(site):
-    make_distribution(site, "thirdparty-broken", {"broken": "thirdparty_broken"}, {"thirdparty_broken": "raise ImportError('needs libfoo')\n"})
+    make_distribution(
+        site,
+        "thirdparty-broken",
+        {"broken": "thirdparty_broken"},
+        {"thirdparty_broken": "raise ImportError('needs libfoo')\n"},
+    )
     m = PluginManager()
     m.load_entry_points()
     with pytest.raises(PluginNotFoundError) as info:
@@ -176,7 +189,9 @@ def test_unknown_kind_is_rejected():
 def test_inhand_task_sets_load_the_published_tasks():
     m = get_manager(reload=True)
     level1 = m.create("task", "inhand-level1")
-    assert (level1.level == 1).sum() == 100  # 10 objects x 2 initial x 5 desired grasps (paper IV-A1)
+    assert (
+        level1.level == 1
+    ).sum() == 100  # 10 objects x 2 initial x 5 desired grasps (paper IV-A1)
     assert len(set(level1.object[level1.level == 1])) == 10
     dmg = m.create("task", "inhand-level3-dmg")
     assert sorted(dmg.object) == ["cracker box", "gelatin box", "potted meat can", "spatula"]

@@ -44,7 +44,10 @@ def test_readme_example(command, expected):
     assert argv[0] == "benchharness"
     proc = subprocess.run(
         [sys.executable, "-m", "benchharness.cli.main", *argv[1:]],
-        capture_output=True, text=True, cwd=ROOT, timeout=300,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
     )
     output = proc.stdout + proc.stderr
     if expected and expected[0].startswith("error:"):

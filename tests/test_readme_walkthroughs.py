@@ -50,17 +50,36 @@ def test_the_readme_has_walkthroughs():
 
 
 def test_walkthroughs_run_as_shown(tmp_path):
-    env = {**os.environ, "BENCHHARNESS_STORE": str(tmp_path / "results.sqlite"), "MPLBACKEND": "Agg"}
+    env = {
+        **os.environ,
+        "BENCHHARNESS_STORE": str(tmp_path / "results.sqlite"),
+        "MPLBACKEND": "Agg",
+    }
     for command, shown in walkthrough_examples():
         argv = shlex.split(command)
         assert argv[0] == "benchharness", command
-        argv = [a if not a.endswith((".png", ".mp4", ".gif")) else str(tmp_path / a) for a in argv[1:]]
-        proc = subprocess.run([sys.executable, "-m", "benchharness.cli.main", *argv, *(
-            ["--no-progress"] if argv[0] in ("run", "compare") else [])],
-            capture_output=True, text=True, cwd=ROOT, timeout=3000, env=env)
+        argv = [
+            a if not a.endswith((".png", ".mp4", ".gif")) else str(tmp_path / a) for a in argv[1:]
+        ]
+        proc = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "benchharness.cli.main",
+                *argv,
+                *(["--no-progress"] if argv[0] in ("run", "compare") else []),
+            ],
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+            timeout=3000,
+            env=env,
+        )
         output = proc.stdout + proc.stderr
         assert proc.returncode in (0, 1), f"{command}\n{output}"
         for line in shown:
             m = re.match(r"│\s+\d+\s+│", line)
             if m:
-                assert m.group(0) in output, f"{command}: trial row {m.group(0)!r} missing\n{output}"
+                assert m.group(0) in output, (
+                    f"{command}: trial row {m.group(0)!r} missing\n{output}"
+                )

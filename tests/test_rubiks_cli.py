@@ -33,17 +33,26 @@ def test_sequence_prints_m_lines_of_n_moves():
 def test_sequence_json():
     r = run("sequence", "--tier", "Rubiks-1-10", "--seed", "3", "--json")
     data = json.loads(r.stdout)
-    assert data["tier"] == "Rubiks-1-10" and data["seed"] == 3 and data["algorithm"] == "benchharness-rubiks-v1"
+    assert (
+        data["tier"] == "Rubiks-1-10"
+        and data["seed"] == 3
+        and data["algorithm"] == "benchharness-rubiks-v1"
+    )
     assert len(data["sequences"]) == 1 and len(data["sequences"][0].split()) == 10
     expect = run("expect", "--sequence", data["sequences"][0])
     assert data["expected_final_from_solved"] == [expect.stdout.strip()]
 
 
 def test_sequence_default_seed_is_zero():
-    assert run("sequence", "--tier", "Rubiks-1-5").stdout == run("sequence", "--tier", "Rubiks-1-5", "--seed", "0").stdout
+    assert (
+        run("sequence", "--tier", "Rubiks-1-5").stdout
+        == run("sequence", "--tier", "Rubiks-1-5", "--seed", "0").stdout
+    )
 
 
-@pytest.mark.parametrize("args", [["--tier", "Rubiks-2-2"], ["--tier", "Rubiks-1-5", "--seed", "-1"]])
+@pytest.mark.parametrize(
+    "args", [["--tier", "Rubiks-2-2"], ["--tier", "Rubiks-1-5", "--seed", "-1"]]
+)
 def test_sequence_bad_input(args):
     r = run("sequence", *args)
     assert r.exit_code == 2
@@ -67,7 +76,7 @@ def test_expect_bad_move():
     r = run("expect", "--sequence", "R U Q U'")
     assert r.exit_code == 2
     assert r.stderr == (
-        "error: --sequence: unknown move \"Q\" at position 3 "
+        'error: --sequence: unknown move "Q" at position 3 '
         "(expected U D L R F B M E S x y z with optional ' or 2)\n"
     )
 
@@ -97,12 +106,23 @@ def test_validate_mismatch_lists_facelets():
 
 
 def test_validate_with_initial_and_json():
-    r = run("validate", "--initial", SEXY_FINAL, "--sequence", "U R U' R'", "--final", SEXY_FINAL, "--json")
+    r = run(
+        "validate",
+        "--initial",
+        SEXY_FINAL,
+        "--sequence",
+        "U R U' R'",
+        "--final",
+        SEXY_FINAL,
+        "--json",
+    )
     assert r.exit_code == 1
     data = json.loads(r.stdout)
     assert data["match"] is False and data["expected_final"] == SOLVED
     assert {"facelet": "U3", "expected": "U", "got": "L"} in data["differences"]
-    r = run("validate", "--initial", SEXY_FINAL, "--sequence", "U R U' R'", "--final", SOLVED, "--json")
+    r = run(
+        "validate", "--initial", SEXY_FINAL, "--sequence", "U R U' R'", "--final", SOLVED, "--json"
+    )
     assert r.exit_code == 0 and json.loads(r.stdout)["match"] is True
 
 
@@ -120,9 +140,15 @@ def test_validate_twisted_corner_final_is_a_negative_answer_with_reason():
     [
         (["--sequence", "R", "--final", SOLVED[:-1]], "--final: expected 54 facelets, got 53"),
         (["--sequence", "R", "--final", "W" + SOLVED[1:]], "--final: invalid character 'W' at U1"),
-        (["--sequence", "R", "--final", "R" + SOLVED[1:]], "--final: each colour must appear exactly 9 times"),
+        (
+            ["--sequence", "R", "--final", "R" + SOLVED[1:]],
+            "--final: each colour must appear exactly 9 times",
+        ),
         (["--sequence", "R Q", "--final", SOLVED], 'unknown move "Q" at position 2'),
-        (["--sequence", "R", "--initial", "R" + SOLVED[1:], "--final", SOLVED], "--initial is not a legal cube"),
+        (
+            ["--sequence", "R", "--initial", "R" + SOLVED[1:], "--final", SOLVED],
+            "--initial is not a legal cube",
+        ),
         (["--sequence", "R"], "Missing option '--final'"),
     ],
 )
@@ -134,10 +160,15 @@ def test_validate_bad_input_exits_2(args, message):
 
 def test_check():
     assert run("check", SOLVED).exit_code == 0
-    flipped = SOLVED[:5] + "R" + SOLVED[6:10] + "U" + SOLVED[11:]  # UR edge flipped in place (U6 <-> R2)
+    flipped = (
+        SOLVED[:5] + "R" + SOLVED[6:10] + "U" + SOLVED[11:]
+    )  # UR edge flipped in place (U6 <-> R2)
     r = run("check", flipped)
     assert r.exit_code == 1
-    assert r.stdout == "invalid: edge flip: the edge orientations sum to 1 mod 2, must be 0 (an edge is flipped in place)\n"
+    assert (
+        r.stdout
+        == "invalid: edge flip: the edge orientations sum to 1 mod 2, must be 0 (an edge is flipped in place)\n"
+    )
 
 
 def test_tiers_text_and_json():
@@ -146,11 +177,18 @@ def test_tiers_text_and_json():
     lines = r.stdout.splitlines()
     assert lines[0].split()[:3] == ["tier", "M", "N"]
     row = next(line for line in lines if line.startswith("Rubiks-5-20"))
-    assert row.split()[:3] == ["Rubiks-5-20", "5", "20"] and "not completed" in row and "416.61 / 23.10 s" in row
+    assert (
+        row.split()[:3] == ["Rubiks-5-20", "5", "20"]
+        and "not completed" in row
+        and "416.61 / 23.10 s" in row
+    )
     data = json.loads(run("tiers", "--json").stdout)
     assert len(data) == 12 and data[6]["name"] == "Rubiks-5-5"
     assert data[6]["baselines"]["dead_reckoning_pr2"] == {
-        "label": "Dead reckoning PR2", "completed": True, "mean_s": 113.35, "std_s": 17.16,
+        "label": "Dead reckoning PR2",
+        "completed": True,
+        "mean_s": 113.35,
+        "std_s": 17.16,
     }
 
 
@@ -165,7 +203,10 @@ def test_score_completed(tmp_path):
     log = write_log(tmp_path, [("Rubiks-1-5", 1, "R U R' U'", SEXY_FINAL, 1.5, 101.75)])
     r = run("score", log)
     assert r.exit_code == 0, r.output
-    assert r.stdout.splitlines()[0] == "Rubiks-1-5: completed, score 100.25 s ± — (mean ± sample std, 1 trial)"
+    assert (
+        r.stdout.splitlines()[0]
+        == "Rubiks-1-5: completed, score 100.25 s ± — (mean ± sample std, 1 trial)"
+    )
     data = json.loads(run("score", log, "--json").stdout)
     tier = data["tiers"][0]
     assert tier["completed"] is True and tier["mean_s"] == 100.25 and tier["std_s"] is None
@@ -188,7 +229,9 @@ def test_score_seed_check(tmp_path):
 def test_score_bad_log(tmp_path):
     log = write_log(tmp_path, [("Rubiks-1-5", 1, "R U R' U'", SEXY_FINAL, 200, 101.75)])
     r = run("score", log)
-    assert r.exit_code == 2 and "termination_s (101.75) is before first_contact_s (200.0)" in r.stderr
+    assert (
+        r.exit_code == 2 and "termination_s (101.75) is before first_contact_s (200.0)" in r.stderr
+    )
     r = run("score", str(tmp_path / "nope.csv"))
     assert r.exit_code == 2
 
@@ -196,4 +239,6 @@ def test_score_bad_log(tmp_path):
 @pytest.mark.parametrize("command", ["tiers", "sequence", "expect", "validate", "check", "score"])
 def test_every_command_has_help_with_an_example(command):
     r = run(command, "--help")
-    assert r.exit_code == 0 and "Example:" in r.stdout and f"benchharness rubiks {command}" in r.stdout
+    assert (
+        r.exit_code == 0 and "Example:" in r.stdout and f"benchharness rubiks {command}" in r.stdout
+    )

@@ -44,7 +44,9 @@ def test_successful_trial_score_is_termination_minus_first_contact():
 def test_failed_trial_has_no_score():
     r = score_trial(trial(final=SOLVED_STRING))
     assert not r.success and r.score_s is None
-    assert r.reason == "observed final state differs from the expected one at 12 facelets"  # 3+3+2+1+1+2, by eye
+    assert (
+        r.reason == "observed final state differs from the expected one at 12 facelets"
+    )  # 3+3+2+1+1+2, by eye
 
 
 def test_failed_trial_may_omit_times():
@@ -63,7 +65,9 @@ def test_illegal_but_well_formed_final_is_a_failure_with_reason():
     s = list(SEQ_FINAL)
     s[5], s[10] = s[10], s[5]  # flip the UR edge in place
     r = score_trial(trial(final="".join(s)))
-    assert not r.success and r.reason.startswith("observed final state is not a legal cube: edge flip")
+    assert not r.success and r.reason.startswith(
+        "observed final state is not a legal cube: edge flip"
+    )
 
 
 @pytest.mark.parametrize(
@@ -95,7 +99,14 @@ def five_trials(times, seed=7):
     tier = get_tier("Rubiks-5-5")
     seqs = tier.sequences(seed)
     return [
-        RubiksTrial("Rubiks-5-5", k, format_sequence(s), expected_final(s), first_contact_s=0.0, termination_s=t)
+        RubiksTrial(
+            "Rubiks-5-5",
+            k,
+            format_sequence(s),
+            expected_final(s),
+            first_contact_s=0.0,
+            termination_s=t,
+        )
         for k, (s, t) in enumerate(zip(seqs, times), start=1)
     ]
 
@@ -137,7 +148,9 @@ def test_missing_and_repeated_trials():
     assert not score.completed and score.problems == ("trial 5 not logged",)
     score = score_tier(trials + [trials[0]], "Rubiks-5-5")
     assert not score.completed and "trial 1 logged more than once" in score.problems
-    stray = RubiksTrial("Rubiks-5-5", 6, trials[0].sequence, trials[0].final, first_contact_s=0, termination_s=1)
+    stray = RubiksTrial(
+        "Rubiks-5-5", 6, trials[0].sequence, trials[0].final, first_contact_s=0, termination_s=1
+    )
     assert "trial 6 outside 1..5" in score_tier(trials + [stray], "Rubiks-5-5").problems
 
 
@@ -168,7 +181,9 @@ def test_csv_log():
     assert t == RubiksTrial("Rubiks-1-5", 1, SEQ, SEQ_FINAL, SOLVED_STRING, 10.0, 130.5, "")
     with pytest.raises(TrialLogError, match="line 2: missing final"):
         parse_csv_log("tier,trial,sequence,final\nRubiks-1-5,1,R,\n")
-    with pytest.raises(TrialLogError, match="line 2: first_contact_s must be a number of seconds, got 'soon'"):
+    with pytest.raises(
+        TrialLogError, match="line 2: first_contact_s must be a number of seconds, got 'soon'"
+    ):
         parse_csv_log("tier,trial,sequence,final,first_contact_s\nRubiks-1-5,1,R,X,soon\n")
     with pytest.raises(TrialLogError, match="unknown field colour"):
         parse_csv_log("tier,trial,sequence,final,colour\nRubiks-1-5,1,R,X,red\n")
@@ -177,8 +192,13 @@ def test_csv_log():
 
 
 def test_json_log_forms(tmp_path):
-    rec = {"trial": 1, "sequence": ["R", "U", "R'", "U'"], "final": SEQ_FINAL,
-           "first_contact_s": 10, "termination_s": 130.5}
+    rec = {
+        "trial": 1,
+        "sequence": ["R", "U", "R'", "U'"],
+        "final": SEQ_FINAL,
+        "first_contact_s": 10,
+        "termination_s": 130.5,
+    }
     as_object = parse_json_log(json.dumps({"tier": "Rubiks-1-5", "trials": [rec]}))
     as_list = parse_json_log(json.dumps([{**rec, "tier": "Rubiks-1-5"}]))
     assert as_object == as_list == parse_csv_log(CSV)

@@ -56,9 +56,8 @@ def test_summary_and_describe():
 
 
 def test_registered_through_the_plugin_hook():
-    from benchharness.plugin import PluginManager
-
     import benchharness_builtins.rubiks_tasks as module
+    from benchharness.plugin import PluginManager
 
     pm = PluginManager()
     pm.register_module(module, entry_point="rubiks_tasks = benchharness_builtins.rubiks_tasks")

@@ -42,6 +42,11 @@ def _load(filename: str, **_: object):
 @hookimpl
 def benchharness_tasks() -> list[Registration]:
     return [
-        Registration(name, partial(_load, filename), summary, meta={"benchmark": "inhand", "file": f"tasks/inhand/{filename}"})
+        Registration(
+            name,
+            partial(_load, filename),
+            summary,
+            meta={"benchmark": "inhand", "file": f"tasks/inhand/{filename}"},
+        )
         for name, (filename, summary) in TASK_SETS.items()
     ]

@@ -37,22 +37,43 @@ def _pr2_gripper(**kwargs):
 def benchharness_robots():
     return [
         Registration(
-            "pr2", _pr2, "Willow Garage PR2: torso, two 7-DOF arms, parallel grippers",
-            meta={"dof": 19, "groups": ["left_arm", "right_arm", "left_gripper", "right_gripper", "torso"],
-                  "urdf": "robots/pr2/pr2.urdf"},
+            "pr2",
+            _pr2,
+            "Willow Garage PR2: torso, two 7-DOF arms, parallel grippers",
+            meta={
+                "dof": 19,
+                "groups": ["left_arm", "right_arm", "left_gripper", "right_gripper", "torso"],
+                "urdf": "robots/pr2/pr2.urdf",
+            },
         ),
         Registration(
-            "herb", _herb, "CMU HERB: two Barrett WAM arms with BarrettHand BH8-280",
-            meta={"dof": 30, "groups": ["left_arm", "right_arm", "left_hand", "right_hand"],
-                  "urdf": "robots/herb/herb.urdf"},
+            "herb",
+            _herb,
+            "CMU HERB: two Barrett WAM arms with BarrettHand BH8-280",
+            meta={
+                "dof": 30,
+                "groups": ["left_arm", "right_arm", "left_hand", "right_hand"],
+                "urdf": "robots/herb/herb.urdf",
+            },
         ),
         Registration(
-            "allegro", _allegro, "Allegro hand v4 (right), 16 joints",
-            meta={"dof": 16, "groups": ["index", "middle", "ring", "thumb", "hand"],
-                  "urdf": "robots/allegro/allegro.urdf"},
+            "allegro",
+            _allegro,
+            "Allegro hand v4 (right), 16 joints",
+            meta={
+                "dof": 16,
+                "groups": ["index", "middle", "ring", "thumb", "hand"],
+                "urdf": "robots/allegro/allegro.urdf",
+            },
         ),
         Registration(
-            "pr2-gripper", _pr2_gripper, "PR2 parallel gripper on a 6-DOF stage (in-hand pivoting / DMG execution)",
-            meta={"dof": 8, "groups": ["stage", "gripper"], "urdf": "robots/pr2_gripper/pr2_gripper.urdf"},
+            "pr2-gripper",
+            _pr2_gripper,
+            "PR2 parallel gripper on a 6-DOF stage (in-hand pivoting / DMG execution)",
+            meta={
+                "dof": 8,
+                "groups": ["stage", "gripper"],
+                "urdf": "robots/pr2_gripper/pr2_gripper.urdf",
+            },
         ),
     ]

@@ -18,7 +18,9 @@ def _config(cls: type, config: Any, kwargs: dict[str, Any]) -> Any:
     names = {f.name for f in fields(cls)}
     own = {k: kwargs.pop(k) for k in list(kwargs) if k in names}
     if config is not None and own:
-        raise TypeError(f"pass either config= or {cls.__name__} fields ({', '.join(sorted(own))}), not both")
+        raise TypeError(
+            f"pass either config= or {cls.__name__} fields ({', '.join(sorted(own))}), not both"
+        )
     return config if config is not None else cls(**own)
 
 
@@ -57,20 +59,29 @@ def benchharness_sensors():
             "head-camera",
             _head_camera,
             "Head RGB-D camera: one-shot cube pose, Gaussian noise (4 mm xy, 2 mm z, 3° yaw)",
-            meta={"config": "benchharness.sensors.HeadCameraConfig", "output": "PoseEstimate (6x6 covariance)"},
+            meta={
+                "config": "benchharness.sensors.HeadCameraConfig",
+                "output": "PoseEstimate (6x6 covariance)",
+            },
         ),
         Registration(
             "pretouch-tof",
             _pretouch,
             "Optical time-of-flight pre-touch emitters on a link (VL6180X-class: 5-100 mm, 1.5 mm noise)",
-            meta={"config": "benchharness.sensors.ToFConfig", "needs": ["backend", "body", "link", "emitters"],
-                  "output": "ToFReading"},
+            meta={
+                "config": "benchharness.sensors.ToFConfig",
+                "needs": ["backend", "body", "link", "emitters"],
+                "output": "ToFReading",
+            },
         ),
         Registration(
             "cube-kf",
             _cube_kf,
             "Iterated EKF over the cube's x, y, z, yaw (mod 90°): predict from commanded motion, update from ToF",
-            meta={"config": "benchharness.sensors.CubeFilterConfig", "state": ["x", "y", "z", "yaw"],
-                  "requires": "filterpy"},
+            meta={
+                "config": "benchharness.sensors.CubeFilterConfig",
+                "state": ["x", "y", "z", "yaw"],
+                "requires": "filterpy",
+            },
         ),
     ]

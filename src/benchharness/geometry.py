@@ -19,8 +19,8 @@ nothing here re-implements quaternion algebra.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Iterable
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -62,15 +62,15 @@ class Pose:
         object.__setattr__(self, "q", _unit_quat(self.q))
 
     @classmethod
-    def identity(cls) -> "Pose":
+    def identity(cls) -> Pose:
         return cls()
 
     @classmethod
-    def from_rotation(cls, p: Iterable[float], rot: Rotation) -> "Pose":
+    def from_rotation(cls, p: Iterable[float], rot: Rotation) -> Pose:
         return cls(np.asarray(p, dtype=float), rot.as_quat())
 
     @classmethod
-    def from_matrix(cls, m: np.ndarray) -> "Pose":
+    def from_matrix(cls, m: np.ndarray) -> Pose:
         m = np.asarray(m, dtype=float)
         if m.shape != (4, 4):
             raise ValueError(f"expected a 4x4 homogeneous matrix, got {m.shape}")
@@ -86,12 +86,12 @@ class Pose:
         m[:3, 3] = self.p
         return m
 
-    def __mul__(self, other: "Pose") -> "Pose":
+    def __mul__(self, other: Pose) -> Pose:
         """Compose: ``(a * b).apply(x) == a.apply(b.apply(x))``."""
         r = self.rotation * other.rotation
         return Pose(self.p + self.rotation.apply(other.p), r.as_quat())
 
-    def inv(self) -> "Pose":
+    def inv(self) -> Pose:
         r_inv = self.rotation.inv()
         return Pose(-r_inv.apply(self.p), r_inv.as_quat())
 
@@ -107,13 +107,13 @@ class Pose:
         return np.concatenate([self.p, self.q])
 
     @classmethod
-    def from_array(cls, a: Iterable[float]) -> "Pose":
+    def from_array(cls, a: Iterable[float]) -> Pose:
         a = np.asarray(a, dtype=float).reshape(-1)
         if a.shape != (7,):
             raise ValueError(f"expected [x, y, z, qx, qy, qz, qw], got {a.shape[0]} numbers")
         return cls(a[:3], a[3:])
 
-    def allclose(self, other: "Pose", atol_p: float = 1e-9, atol_q: float = 1e-9) -> bool:
+    def allclose(self, other: Pose, atol_p: float = 1e-9, atol_q: float = 1e-9) -> bool:
         """Equal as transforms: q and -q are the same rotation."""
         dq = min(np.linalg.norm(self.q - other.q), np.linalg.norm(self.q + other.q))
         return bool(np.linalg.norm(self.p - other.p) <= atol_p and dq <= atol_q)

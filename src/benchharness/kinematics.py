@@ -25,9 +25,9 @@ batched solver. A seeded call now costs a few ms.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import numpy as np
 import torch
@@ -67,8 +67,12 @@ class IKConfig:
     returned errors are what was actually reached.
     """
 
-    num_retries: int = 4  #: restarts per target in the first pass: the seed (if given) plus random configurations
-    retry_num_retries: int = 24  #: restarts in a second pass over only the targets the first pass missed
+    num_retries: int = (
+        4  #: restarts per target in the first pass: the seed (if given) plus random configurations
+    )
+    retry_num_retries: int = (
+        24  #: restarts in a second pass over only the targets the first pass missed
+    )
     max_iterations: int = 80  #: DLS iterations per restart in the first pass
     retry_max_iterations: int = 80  #: DLS iterations in the second pass
     pos_tolerance: float = 1e-4  #: m, a restart counts as converged below this ...
@@ -117,20 +121,48 @@ def _quat_wxyz(r: np.ndarray) -> np.ndarray:
         a = r[sel]
         if case == 0:
             t = np.sqrt(1.0 + tr[sel]) * 2.0
-            q[sel] = np.stack([0.25 * t, (a[:, 2, 1] - a[:, 1, 2]) / t, (a[:, 0, 2] - a[:, 2, 0]) / t,
-                               (a[:, 1, 0] - a[:, 0, 1]) / t], axis=1)
+            q[sel] = np.stack(
+                [
+                    0.25 * t,
+                    (a[:, 2, 1] - a[:, 1, 2]) / t,
+                    (a[:, 0, 2] - a[:, 2, 0]) / t,
+                    (a[:, 1, 0] - a[:, 0, 1]) / t,
+                ],
+                axis=1,
+            )
         elif case == 1:
             t = np.sqrt(1.0 + a[:, 0, 0] - a[:, 1, 1] - a[:, 2, 2]) * 2.0
-            q[sel] = np.stack([(a[:, 2, 1] - a[:, 1, 2]) / t, 0.25 * t, (a[:, 0, 1] + a[:, 1, 0]) / t,
-                               (a[:, 0, 2] + a[:, 2, 0]) / t], axis=1)
+            q[sel] = np.stack(
+                [
+                    (a[:, 2, 1] - a[:, 1, 2]) / t,
+                    0.25 * t,
+                    (a[:, 0, 1] + a[:, 1, 0]) / t,
+                    (a[:, 0, 2] + a[:, 2, 0]) / t,
+                ],
+                axis=1,
+            )
         elif case == 2:
             t = np.sqrt(1.0 + a[:, 1, 1] - a[:, 0, 0] - a[:, 2, 2]) * 2.0
-            q[sel] = np.stack([(a[:, 0, 2] - a[:, 2, 0]) / t, (a[:, 0, 1] + a[:, 1, 0]) / t, 0.25 * t,
-                               (a[:, 1, 2] + a[:, 2, 1]) / t], axis=1)
+            q[sel] = np.stack(
+                [
+                    (a[:, 0, 2] - a[:, 2, 0]) / t,
+                    (a[:, 0, 1] + a[:, 1, 0]) / t,
+                    0.25 * t,
+                    (a[:, 1, 2] + a[:, 2, 1]) / t,
+                ],
+                axis=1,
+            )
         else:
             t = np.sqrt(1.0 + a[:, 2, 2] - a[:, 0, 0] - a[:, 1, 1]) * 2.0
-            q[sel] = np.stack([(a[:, 1, 0] - a[:, 0, 1]) / t, (a[:, 0, 2] + a[:, 2, 0]) / t,
-                               (a[:, 1, 2] + a[:, 2, 1]) / t, 0.25 * t], axis=1)
+            q[sel] = np.stack(
+                [
+                    (a[:, 1, 0] - a[:, 0, 1]) / t,
+                    (a[:, 0, 2] + a[:, 2, 0]) / t,
+                    (a[:, 1, 2] + a[:, 2, 1]) / t,
+                    0.25 * t,
+                ],
+                axis=1,
+            )
     q *= np.where(q[:, :1] < 0, -1.0, 1.0)
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
@@ -143,7 +175,9 @@ def _rotvec_between(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     the axis comes from the quaternion instead.
     """
     r = target @ current.transpose(0, 2, 1)
-    v = 0.5 * np.stack([r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1)
+    v = 0.5 * np.stack(
+        [r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1
+    )
     n = np.sqrt(np.sum(v * v, axis=1))
     angle = np.arctan2(n, 0.5 * (r[:, 0, 0] + r[:, 1, 1] + r[:, 2, 2] - 1.0))
     out = v * (angle / np.maximum(n, 1e-300))[:, None]  # n = 0 only at angle 0 (angle pi: below)
@@ -201,7 +235,9 @@ class _SerialModel:
         self._pris = np.array(self.prismatic, dtype=float)  # (K,)
         rev = (1.0 - self._pris)[:, None, None]
         self._eye3 = np.eye(3)
-        self._skew = rev * np.stack([np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]) for x, y, z in self.axis])
+        self._skew = rev * np.stack(
+            [np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]) for x, y, z in self.axis]
+        )
         self._skew2 = self._skew @ self._skew
         self._pris_mask = np.array(self.prismatic, dtype=bool)[None, :, None]  # (1, K, 1)
         self._any_prismatic = bool(self._pris_mask.any())
@@ -237,7 +273,9 @@ class _SerialModel:
         d = tip[:, None, :3, 3] - frames[:, :, :3, 3]
         zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
         dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
-        jv = np.stack([zy * dz - zz * dy, zz * dx - zx * dz, zx * dy - zy * dx], axis=2)  # z x d (np.cross: ~80 us)
+        jv = np.stack(
+            [zy * dz - zz * dy, zz * dx - zx * dz, zx * dy - zy * dx], axis=2
+        )  # z x d (np.cross: ~80 us)
         if self._any_prismatic:
             jv = np.where(self._pris_mask, z, jv)
         jw = z if not self._any_prismatic else np.where(self._pris_mask, 0.0, z)
@@ -256,14 +294,18 @@ class KinematicChain:
         text = _read(urdf)
         self.root_link = root_link
         self.tip_link = tip_link
-        self.chain = _quiet_build(pk.build_serial_chain_from_urdf, text.encode(), tip_link, root_link).to(dtype=DTYPE)
+        self.chain = _quiet_build(
+            pk.build_serial_chain_from_urdf, text.encode(), tip_link, root_link
+        ).to(dtype=DTYPE)
         self.joint_names: list[str] = list(self.chain.get_joint_parameter_names(exclude_fixed=True))
         low, high = self.chain.get_joint_limits()
         self.lower = np.asarray(low, dtype=float)
         self.upper = np.asarray(high, dtype=float)
         # Continuous joints (e.g. a full pr2_description's forearm/wrist roll) are searched over
         # [-pi, pi]: every angle is reachable there, and IK needs finite bounds to sample and clamp.
-        unbounded = ~(np.isfinite(self.lower) & np.isfinite(self.upper)) | (self.lower >= self.upper)
+        unbounded = ~(np.isfinite(self.lower) & np.isfinite(self.upper)) | (
+            self.lower >= self.upper
+        )
         if unbounded.any():
             self.lower[unbounded], self.upper[unbounded] = -np.pi, np.pi
             self.chain.low = torch.as_tensor(self.lower, dtype=DTYPE)
@@ -343,32 +385,65 @@ class KinematicChain:
         """
         tgt = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
         gen = generator if generator is not None else torch.Generator().manual_seed(seed)
-        ref = None if seed_q is None else np.broadcast_to(np.asarray(seed_q, dtype=float).reshape(-1, self.dof), (tgt.shape[0], self.dof))
+        ref = (
+            None
+            if seed_q is None
+            else np.broadcast_to(
+                np.asarray(seed_q, dtype=float).reshape(-1, self.dof), (tgt.shape[0], self.dof)
+            )
+        )
         if ref is not None and config.seed_first and self._np is not None:
             first = self._ik_seeded(tgt, ref, config)
             miss = np.flatnonzero(~first.success)
             if miss.size == 0:
                 return first
             rest = self._ik_restarts(tgt[miss], ref[miss], gen, config)
-            better = rest.success | (rest.pos_error + 0.1 * rest.rot_error < first.pos_error[miss] + 0.1 * first.rot_error[miss])
+            better = rest.success | (
+                rest.pos_error + 0.1 * rest.rot_error
+                < first.pos_error[miss] + 0.1 * first.rot_error[miss]
+            )
             rows = miss[better]
-            q, ok, dp, dr = first.q.copy(), first.success.copy(), first.pos_error.copy(), first.rot_error.copy()
-            q[rows], ok[rows], dp[rows], dr[rows] = (rest.q[better], rest.success[better],
-                                                     rest.pos_error[better], rest.rot_error[better])
+            q, ok, dp, dr = (
+                first.q.copy(),
+                first.success.copy(),
+                first.pos_error.copy(),
+                first.rot_error.copy(),
+            )
+            q[rows], ok[rows], dp[rows], dr[rows] = (
+                rest.q[better],
+                rest.success[better],
+                rest.pos_error[better],
+                rest.rot_error[better],
+            )
             return IKResult(q, ok, dp, dr)
         return self._ik_restarts(tgt, ref, gen, config)
 
     def _ik_seeded(self, tgt: np.ndarray, ref: np.ndarray, config: IKConfig) -> IKResult:
         """Damped least squares from the seed alone, per target, stopping at convergence (NumPy)."""
-        q, _, _, _ = self._dls(tgt, np.clip(np.asarray(ref, dtype=float), self.lower, self.upper)[:, None, :],
-                               config, config.max_iterations, stop_when_any=True)
+        q, _, _, _ = self._dls(
+            tgt,
+            np.clip(np.asarray(ref, dtype=float), self.lower, self.upper)[:, None, :],
+            config,
+            config.max_iterations,
+            stop_when_any=True,
+        )
         q = q[:, 0]
-        dp, dr = pose_error(self.fk(q) if q.shape[0] <= _NUMPY_FK_MAX_BATCH else self._np.fk_jacobian(q)[0], tgt)
-        ok = (dp <= max(config.pos_tolerance, 1e-9) * 1.0001) & (dr <= config.rot_tolerance * 1.0001)
+        dp, dr = pose_error(
+            self.fk(q) if q.shape[0] <= _NUMPY_FK_MAX_BATCH else self._np.fk_jacobian(q)[0], tgt
+        )
+        ok = (dp <= max(config.pos_tolerance, 1e-9) * 1.0001) & (
+            dr <= config.rot_tolerance * 1.0001
+        )
         return IKResult(q=q, success=ok, pos_error=dp, rot_error=dr)
 
     def _dls(
-        self, tgt: np.ndarray, init: np.ndarray, config: IKConfig, iterations: int, *, stop_when_any: bool
+        self,
+        tgt: np.ndarray,
+        init: np.ndarray,
+        config: IKConfig,
+        iterations: int,
+        *,
+        stop_when_any: bool,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """pytorch-kinematics' ``PseudoInverseIK.solve`` in NumPy, for B targets x R restarts ``init``.
 
@@ -397,7 +472,9 @@ class KinematicChain:
 
         def error(qq: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             tip, jac = model.fk_jacobian(qq)
-            dx = np.concatenate([tpos[rows] - tip[:, :3, 3], _rotvec_between(trot[rows], tip[:, :3, :3])], axis=1)
+            dx = np.concatenate(
+                [tpos[rows] - tip[:, :3, 3], _rotvec_between(trot[rows], tip[:, :3, :3])], axis=1
+            )
             return dx, jac
 
         def step(qq: np.ndarray, dx: np.ndarray, jac: np.ndarray) -> np.ndarray:
@@ -414,7 +491,9 @@ class KinematicChain:
                 break
             qa = q[idx]
             dx, jac = error(qa, idx)
-            conv = (np.linalg.norm(dx[:, :3], axis=1) < pos_tol) & (np.linalg.norm(dx[:, 3:], axis=1) < rot_tol)
+            conv = (np.linalg.norm(dx[:, :3], axis=1) < pos_tol) & (
+                np.linalg.norm(dx[:, 3:], axis=1) < rot_tol
+            )
             sol[idx] = qa  # converged rows keep this; the others are overwritten while they run
             active[idx[conv]] = False
             if stop_when_any and conv.any():
@@ -435,19 +514,39 @@ class KinematicChain:
         conv = (ep < pos_tol) & (er < rot_tol)
         return q.reshape(b, r, dof), ep.reshape(b, r), er.reshape(b, r), conv.reshape(b, r)
 
-    def _ik_restarts(self, tgt: np.ndarray, ref: np.ndarray | None, gen: torch.Generator, config: IKConfig) -> IKResult:
+    def _ik_restarts(
+        self, tgt: np.ndarray, ref: np.ndarray | None, gen: torch.Generator, config: IKConfig
+    ) -> IKResult:
         """The batched pytorch-kinematics solver: seed (if any) + random restarts, two passes."""
         res = self._ik_pass(tgt, ref, gen, config, config.num_retries, config.max_iterations)
         miss = np.flatnonzero(~res.success)
         if miss.size and config.retry_num_retries > 0:
-            again = self._ik_pass(tgt[miss], None if ref is None else ref[miss], gen, config,
-                                  config.retry_num_retries, config.retry_max_iterations)
-            better = again.pos_error + 0.1 * again.rot_error < res.pos_error[miss] + 0.1 * res.rot_error[miss]
+            again = self._ik_pass(
+                tgt[miss],
+                None if ref is None else ref[miss],
+                gen,
+                config,
+                config.retry_num_retries,
+                config.retry_max_iterations,
+            )
+            better = (
+                again.pos_error + 0.1 * again.rot_error
+                < res.pos_error[miss] + 0.1 * res.rot_error[miss]
+            )
             better |= again.success
             rows = miss[better]
-            q, ok, dp, dr = res.q.copy(), res.success.copy(), res.pos_error.copy(), res.rot_error.copy()
-            q[rows], ok[rows], dp[rows], dr[rows] = (again.q[better], again.success[better],
-                                                     again.pos_error[better], again.rot_error[better])
+            q, ok, dp, dr = (
+                res.q.copy(),
+                res.success.copy(),
+                res.pos_error.copy(),
+                res.rot_error.copy(),
+            )
+            q[rows], ok[rows], dp[rows], dr[rows] = (
+                again.q[better],
+                again.success[better],
+                again.pos_error[better],
+                again.rot_error[better],
+            )
             res = IKResult(q, ok, dp, dr)
         return res
 
@@ -465,10 +564,18 @@ class KinematicChain:
         init = torch.as_tensor(self.sample(b * r, gen), dtype=DTYPE).reshape(b, r, self.dof)
         ref = None
         if seed_q is not None:
-            ref = torch.as_tensor(np.array(seed_q, dtype=float), dtype=DTYPE).reshape(-1, self.dof).expand(b, self.dof)
-            init[:, 0, :] = torch.clamp(ref, torch.as_tensor(self.lower), torch.as_tensor(self.upper))
+            ref = (
+                torch.as_tensor(np.array(seed_q, dtype=float), dtype=DTYPE)
+                .reshape(-1, self.dof)
+                .expand(b, self.dof)
+            )
+            init[:, 0, :] = torch.clamp(
+                ref, torch.as_tensor(self.lower), torch.as_tensor(self.upper)
+            )
         if self._np is not None and b * r <= _NUMPY_IK_MAX_ROWS:
-            qn, ep, er, cv = self._dls(targets, init.numpy(), config, iterations, stop_when_any=ref is None)
+            qn, ep, er, cv = self._dls(
+                targets, init.numpy(), config, iterations, stop_when_any=ref is None
+            )
             q, conv = torch.as_tensor(qn), torch.as_tensor(cv)
             err = torch.as_tensor(ep + 0.1 * er)
         else:
@@ -482,11 +589,19 @@ class KinematicChain:
         qb = q[idx, best].clamp(torch.as_tensor(self.lower), torch.as_tensor(self.upper))
         reached = self.fk(qb.numpy())
         dp, dr = pose_error(reached, tgt.numpy())
-        ok = (dp <= max(config.pos_tolerance, 1e-9) * 1.0001) & (dr <= config.rot_tolerance * 1.0001)
+        ok = (dp <= max(config.pos_tolerance, 1e-9) * 1.0001) & (
+            dr <= config.rot_tolerance * 1.0001
+        )
         return IKResult(q=qb.numpy(), success=ok, pos_error=dp, rot_error=dr)
 
-    def _pk_solve(self, tgt: torch.Tensor, init: torch.Tensor, config: IKConfig, iterations: int,
-                  any_converged: bool) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    def _pk_solve(
+        self,
+        tgt: torch.Tensor,
+        init: torch.Tensor,
+        config: IKConfig,
+        iterations: int,
+        any_converged: bool,
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """pytorch-kinematics' batched ``PseudoInverseIK`` (large batches): q (B, R, dof), error, converged."""
         solver = pk.PseudoInverseIK(
             self.chain,

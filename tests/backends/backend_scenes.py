@@ -43,10 +43,22 @@ class GripperScene:
 
     def command(self) -> None:
         b = self.backend
-        b.set_joint_targets(self.gripper, [self.lift_z], joints=["lift"], stiffness=LIFT_K, damping=LIFT_D,
-                            force_limit=LIFT_FMAX)
-        b.set_joint_targets(self.gripper, [self.finger_q, self.finger_q], joints=["left_finger", "right_finger"],
-                            stiffness=FINGER_K, damping=FINGER_D, force_limit=FINGER_FMAX)
+        b.set_joint_targets(
+            self.gripper,
+            [self.lift_z],
+            joints=["lift"],
+            stiffness=LIFT_K,
+            damping=LIFT_D,
+            force_limit=LIFT_FMAX,
+        )
+        b.set_joint_targets(
+            self.gripper,
+            [self.finger_q, self.finger_q],
+            joints=["left_finger", "right_finger"],
+            stiffness=FINGER_K,
+            damping=FINGER_D,
+            force_limit=FINGER_FMAX,
+        )
 
     def cube_in_palm(self) -> np.ndarray:
         b = self.backend
@@ -57,8 +69,12 @@ def gripper_scene(backend: Backend) -> GripperScene:
     """The gripper open above a 5.7 cm, 94 g cube resting on the ground."""
     g = backend.add_ground(0.0, friction=1.0)
     grip = backend.load_urdf(GRIPPER_URDF, Pose(), fixed_base=True, name="gripper")
-    cube = backend.add_body([Box((CUBE_HALF,) * 3)], Pose([0, 0, CUBE_HALF]), CUBE_MASS, friction=1.0, name="cube")
-    backend.set_joint_positions(grip, [GRASP_Z, OPEN_Q, OPEN_Q], joints=["lift", "left_finger", "right_finger"])
+    cube = backend.add_body(
+        [Box((CUBE_HALF,) * 3)], Pose([0, 0, CUBE_HALF]), CUBE_MASS, friction=1.0, name="cube"
+    )
+    backend.set_joint_positions(
+        grip, [GRASP_Z, OPEN_Q, OPEN_Q], joints=["lift", "left_finger", "right_finger"]
+    )
     s = GripperScene(backend, g, grip, cube)
     s.command()
     return s
@@ -83,7 +99,9 @@ def grasp_lift_hold(s: GripperScene, hold_s: float = 5.0, lift: float = 0.10) ->
     end_rel = s.cube_in_palm()
     forces = {}
     for link in ("pad_l", "pad_r"):
-        forces[link] = sum(c.normal_force for c in b.contacts(s.gripper, s.cube) if c.link_a == link)
+        forces[link] = sum(
+            c.normal_force for c in b.contacts(s.gripper, s.cube) if c.link_a == link
+        )
     return {
         "grasp_rel": grasp_rel,
         "lifted_rel": lifted_rel,

@@ -6,8 +6,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # backend_scenes.py
 
-from benchharness.backends import Backend, PhysicsConfig  # noqa: E402
-from benchharness.plugin import get_manager  # noqa: E402
+from benchharness.backends import Backend, PhysicsConfig
+from benchharness.plugin import get_manager
 
 BACKEND_ITEMS = get_manager().items("backend")
 

@@ -14,6 +14,22 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from backend_scenes import (
+    ARM_URDF,
+    ASSETS,
+    CUBE_HALF,
+    CUBE_MASS,
+    GRASP_Z,
+    GRIPPER_URDF,
+    OPEN_Q,
+    PAD_OFFSET,
+    ROTOR_URDF,
+    SQUEEZE,
+    GripperScene,
+    grasp_lift_hold,
+    gripper_scene,
+    trajectory_digest,
+)
 from scipy.spatial.transform import Rotation
 
 from benchharness.backends import (
@@ -28,23 +44,6 @@ from benchharness.backends import (
     Sphere,
 )
 from benchharness.geometry import Pose
-
-from backend_scenes import (
-    ARM_URDF,
-    CUBE_HALF,
-    CUBE_MASS,
-    GRASP_Z,
-    OPEN_Q,
-    PAD_OFFSET,
-    SQUEEZE,
-    GripperScene,
-    GRIPPER_URDF,
-    ROTOR_URDF,
-    ASSETS,
-    grasp_lift_hold,
-    gripper_scene,
-    trajectory_digest,
-)
 
 G = 9.81
 
@@ -75,14 +74,18 @@ def test_pose_velocity_roundtrip(backend: Backend):
     backend.set_pose(b, pose)  # keeps velocity
     assert backend.get_pose(b).allclose(pose, atol_p=1e-6, atol_q=1e-6)
     lin, ang = backend.get_velocity(b)
-    assert np.allclose(lin, [0.1, 0.2, 0.3], atol=1e-6) and np.allclose(ang, [0.5, -0.4, 0.2], atol=1e-6)
+    assert np.allclose(lin, [0.1, 0.2, 0.3], atol=1e-6) and np.allclose(
+        ang, [0.5, -0.4, 0.2], atol=1e-6
+    )
     assert backend.get_mass(b) == pytest.approx(2.0)
 
 
 def test_shapes_rest_at_their_height(backend: Backend):
     """Each primitive, resting on the ground, has its lowest point at z = 0 (within 1 mm)."""
     backend.add_ground()
-    verts = np.array([[x, y, z] for x in (-0.03, 0.03) for y in (-0.02, 0.02) for z in (-0.01, 0.01)])
+    verts = np.array(
+        [[x, y, z] for x in (-0.03, 0.03) for y in (-0.02, 0.02) for z in (-0.01, 0.01)]
+    )
     faces = np.array([[0, 1, 2]])
     cases = [
         (Box((0.03, 0.02, 0.01)), 0.01),
@@ -103,8 +106,13 @@ def test_shapes_rest_at_their_height(backend: Backend):
 def test_compound_body(backend: Backend):
     """A box with a convex-mesh foot rests on the foot; uniform density puts the COM between them."""
     backend.add_ground()
-    foot = np.array([[x, y, z] for x in (-0.02, 0.02) for y in (-0.02, 0.02) for z in (-0.01, 0.01)])
-    shapes = [Box((0.05, 0.05, 0.05)), MeshShape(foot, np.zeros((0, 3), dtype=int), Pose([0, 0, -0.06]))]
+    foot = np.array(
+        [[x, y, z] for x in (-0.02, 0.02) for y in (-0.02, 0.02) for z in (-0.01, 0.01)]
+    )
+    shapes = [
+        Box((0.05, 0.05, 0.05)),
+        MeshShape(foot, np.zeros((0, 3), dtype=int), Pose([0, 0, -0.06])),
+    ]
     if not backend.capabilities.mesh_collision:
         shapes = shapes[:1]
     b = backend.add_body(shapes, Pose([0, 0, 0.072]), 1.0)
@@ -138,7 +146,12 @@ def test_urdf_joint_and_link_info(backend: Backend):
     arm = backend.load_urdf(ARM_URDF, Pose([0.5, 0, 0]))
     info = backend.joint_info(arm)
     assert [j.name for j in info] == ["yaw", "pitch"] == backend.joint_names(arm)
-    assert (info[0].lower, info[0].upper, info[0].max_effort, info[0].max_velocity) == (-3.0, 3.0, 50.0, 3.0)
+    assert (info[0].lower, info[0].upper, info[0].max_effort, info[0].max_velocity) == (
+        -3.0,
+        3.0,
+        50.0,
+        3.0,
+    )
     assert (info[1].parent_link, info[1].child_link, info[1].type) == ("upper", "fore", "revolute")
     assert backend.link_names(arm) == ["base", "upper", "fore", "tip"]
     assert backend.get_mass(arm) == pytest.approx(2.85)
@@ -178,7 +191,11 @@ def test_pd_gains_are_physical(backend: Backend):
     for _ in range(int(1.0 / backend.config.timestep)):
         backend.step()
         t = backend.time
-        qa = 0.5 * (1 - math.exp(-z * w * t) * (math.cos(wd * t) + z / math.sqrt(1 - z * z) * math.sin(wd * t)))
+        qa = 0.5 * (
+            1
+            - math.exp(-z * w * t)
+            * (math.cos(wd * t) + z / math.sqrt(1 - z * z) * math.sin(wd * t))
+        )
         worst = max(worst, abs(backend.get_joint_state(rot).positions[0] - qa))
     assert worst < 0.01
 
@@ -202,7 +219,9 @@ def test_gravity_torques(backend: Backend):
         return
     for q in ([0.7, -0.5], [0.0, 0.0], [-1.0, 1.2]):
         backend.set_joint_positions(arm, q)
-        assert backend.gravity_torques(arm) == pytest.approx([0.0, -G * 0.04 * math.cos(q[1])], abs=1e-5)
+        assert backend.gravity_torques(arm) == pytest.approx(
+            [0.0, -G * 0.04 * math.cos(q[1])], abs=1e-5
+        )
     names = backend.joint_names(arm)
     base = Pose([-0.5, 0.3, 0.2], Rotation.from_euler("xyz", [0.4, -0.3, 0.2]).as_quat())
     q = np.array([0.6, -0.4])
@@ -268,7 +287,9 @@ def test_free_base_articulation_drives(backend: Backend):
 def test_force_limit_caps_the_drive(backend: Backend):
     """A drive capped below the gravity torque (0.39 N m) cannot hold the forearm up."""
     arm = backend.load_urdf(ARM_URDF, Pose())
-    backend.set_joint_targets(arm, [0.0, 0.0], stiffness=1000.0, damping=10.0, force_limit=[50.0, 0.2])
+    backend.set_joint_targets(
+        arm, [0.0, 0.0], stiffness=1000.0, damping=10.0, force_limit=[50.0, 0.2]
+    )
     backend.step(120)
     assert backend.get_joint_state(arm).positions[1] > 0.3  # pitch about +y: the tip drops
 
@@ -304,11 +325,15 @@ def test_self_collision_filtering(backend: Backend):
     # the gripper's pads (siblings' children) do collide: closing fully stops the fingers at q = 9 mm
     grip = backend.load_urdf(GRIPPER_URDF, Pose([1.0, 0, 0]))
     backend.set_joint_positions(grip, [0.3, 0.03, 0.03])
-    backend.set_joint_targets(grip, [0.3, 0.0, 0.0], stiffness=[20000.0, 2000.0, 2000.0], damping=[1000.0, 40.0, 40.0])
+    backend.set_joint_targets(
+        grip, [0.3, 0.0, 0.0], stiffness=[20000.0, 2000.0, 2000.0], damping=[1000.0, 40.0, 40.0]
+    )
     backend.step(120)
     q = backend.get_joint_state(grip).positions
     assert q[1:] == pytest.approx([0.009, 0.009], abs=1e-3)
-    pads = {frozenset((c.link_a, c.link_b)) for c in backend.contacts(grip, grip) if c.normal_force > 0}
+    pads = {
+        frozenset((c.link_a, c.link_b)) for c in backend.contacts(grip, grip) if c.normal_force > 0
+    }
     assert frozenset(("pad_l", "pad_r")) in pads
 
 
@@ -328,7 +353,11 @@ def test_ray_cast(backend: Backend):
     r = backend.ray_cast(np.array([[0.0, 0.1, 0.2]]), np.array([[1.0, 0, 0]]), 1.0)
     assert r.hit[0] and r.distance[0] == pytest.approx(0.25, abs=1e-3)
     # misses: nothing there, and too short
-    r = backend.ray_cast(np.array([[5.0, 5.0, 1.0], [0.3, 0.1, 1.0]]), np.array([[0, 0, 1.0], [0, 0, -1.0]]), [2.0, 0.5])
+    r = backend.ray_cast(
+        np.array([[5.0, 5.0, 1.0], [0.3, 0.1, 1.0]]),
+        np.array([[0, 0, 1.0], [0, 0, -1.0]]),
+        [2.0, 0.5],
+    )
     assert not r.hit.any() and np.isinf(r.distance).all() and np.isnan(r.point).all()
     assert np.isnan(r.normal).all() and (r.body == -1).all()
     # ignore_bodies: through the box to the ground
@@ -349,7 +378,9 @@ def test_ray_cast_ignore_links(backend: Backend):
     arm = backend.load_urdf(ARM_URDF, Pose([0.0, 0.0, 0.2]))
     box = backend.add_body([Box((0.05, 0.05, 0.05))], Pose([0.0, 0.0, 0.05]), 1.0, fixed=True)
     backend.set_joint_targets(arm, [0.0, 0.0], stiffness=1000.0, damping=10.0)
-    backend.step(1)  # PhysX's scene queries see a just-loaded articulation's links only after a step
+    backend.step(
+        1
+    )  # PhysX's scene queries see a just-loaded articulation's links only after a step
     o, d = np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, -1.0]])
     r = backend.ray_cast(o, d, 2.0)
     assert r.hit[0] and r.body[0] == arm and r.distance[0] == pytest.approx(0.52, abs=1e-3)
@@ -392,15 +423,26 @@ def test_pinch_torsional_friction_is_a_pad_patch(make):
     backend = make(gravity=(0.0, 0.0, 0.0))
     inertia = 0.01  # kg m^2
     grip = backend.load_urdf(GRIPPER_URDF, Pose(), fixed_base=True, name="gripper")
-    cube = backend.add_body([Box((CUBE_HALF,) * 3)], Pose([0, 0, CUBE_HALF]), CUBE_MASS, friction=1.0,
-                            name="cube", inertia_diag=[inertia] * 3)
-    backend.set_joint_positions(grip, [GRASP_Z, OPEN_Q, OPEN_Q], joints=["lift", "left_finger", "right_finger"])
+    cube = backend.add_body(
+        [Box((CUBE_HALF,) * 3)],
+        Pose([0, 0, CUBE_HALF]),
+        CUBE_MASS,
+        friction=1.0,
+        name="cube",
+        inertia_diag=[inertia] * 3,
+    )
+    backend.set_joint_positions(
+        grip, [GRASP_Z, OPEN_Q, OPEN_Q], joints=["lift", "left_finger", "right_finger"]
+    )
     s = GripperScene(backend, -1, grip, cube)
     s.finger_q = CUBE_HALF + PAD_OFFSET - SQUEEZE
     s.command()
     dt = backend.config.timestep
     backend.step(int(0.3 / dt))
-    forces = [sum(c.normal_force for c in backend.contacts(grip, cube) if c.link_a == link) for link in ("pad_l", "pad_r")]
+    forces = [
+        sum(c.normal_force for c in backend.contacts(grip, cube) if c.link_a == link)
+        for link in ("pad_l", "pad_r")
+    ]
     assert forces == pytest.approx([20.0, 20.0], rel=0.05)
     w0 = 3.0
     backend.set_velocity(cube, [0.0, 0.0, 0.0], [0.0, w0, 0.0])
@@ -448,7 +490,10 @@ def test_remove_and_replace_without_jump(backend: Backend):
     backend.remove_body(cube)
     with pytest.raises(BackendError):
         backend.get_pose(cube)
-    slabs = [Box((CUBE_HALF, CUBE_HALF, CUBE_HALF / 3), Pose([0, 0, dz])) for dz in (-2 * CUBE_HALF / 3, 0.0, 2 * CUBE_HALF / 3)]
+    slabs = [
+        Box((CUBE_HALF, CUBE_HALF, CUBE_HALF / 3), Pose([0, 0, dz]))
+        for dz in (-2 * CUBE_HALF / 3, 0.0, 2 * CUBE_HALF / 3)
+    ]
     new = backend.add_body(slabs, pose, CUBE_MASS)
     backend.set_velocity(new, lin, ang)
     backend.step(120)
@@ -462,7 +507,9 @@ def test_remove_and_replace_without_jump(backend: Backend):
     with pytest.raises(BackendError):
         backend.detach(c)
     backend.step(12)
-    assert backend.get_pose(ball).p[2] == pytest.approx(0.45 - 0.5 * G * (12 * backend.config.timestep) ** 2, abs=2e-3)
+    assert backend.get_pose(ball).p[2] == pytest.approx(
+        0.45 - 0.5 * G * (12 * backend.config.timestep) ** 2, abs=2e-3
+    )
 
 
 # -- robustness --------------------------------------------------------------------
@@ -476,7 +523,10 @@ def test_determinism_across_processes(item):
         f"import sys; sys.path.insert(0, {str(here)!r}); from backend_scenes import trajectory_digest; "
         f"print(trajectory_digest({item.name!r}, 0.3))"
     )
-    procs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    procs = [
+        subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+        for _ in range(2)
+    ]
     here_digest = trajectory_digest(item.name, 0.3)
     outs = []
     for p in procs:

@@ -81,7 +81,10 @@ def finger_joints(segments: list) -> list[str]:
 def gripper_urdf(name: str, finger_axis: str, segments: list, wrist: bool, pad_width: float) -> str:
     """Pads on prismatic joints along ±``finger_axis``; joint q = the pad face's distance from the axis."""
     ax = {"x": (1, 0, 0), "y": (0, 1, 0)}[finger_axis]
-    parts = [f'<?xml version="1.0"?><robot name="{name}">', f'<link name="base">{_inertial(1.0, 1e-3)}</link>']
+    parts = [
+        f'<?xml version="1.0"?><robot name="{name}">',
+        f'<link name="base">{_inertial(1.0, 1e-3)}</link>',
+    ]
     parent = "base"
     if wrist:
         parts += [
@@ -136,12 +139,22 @@ class TwistRig:
             targets += [q, q]
             caps += [2 * grip, 2 * grip]
         self.backend.set_joint_targets(
-            body, targets, joints=finger_joints(segments), stiffness=FINGER_K, damping=FINGER_D, force_limit=caps
+            body,
+            targets,
+            joints=finger_joints(segments),
+            stiffness=FINGER_K,
+            damping=FINGER_D,
+            force_limit=caps,
         )
 
     def wrist(self, angle: float) -> None:
         self.backend.set_joint_targets(
-            self.rotator, [angle], joints=["wrist"], stiffness=WRIST_K, damping=WRIST_D, force_limit=WRIST_TMAX
+            self.rotator,
+            [angle],
+            joints=["wrist"],
+            stiffness=WRIST_K,
+            damping=WRIST_D,
+            force_limit=WRIST_TMAX,
         )
 
     def seconds(self, t: float) -> int:
@@ -157,7 +170,11 @@ AXIS_UP = {
 
 
 def build_rig(
-    backend: Backend, grasp: str, config: CubeConfig | None = None, axis: str = "z", cube_pose: Pose | None = None
+    backend: Backend,
+    grasp: str,
+    config: CubeConfig | None = None,
+    axis: str = "z",
+    cube_pose: Pose | None = None,
 ) -> TwistRig:
     """The cube held in the air by the holder (a grasp of HOLDER_SEGMENTS) and the rotator on its top slab.
 
@@ -167,10 +184,20 @@ def build_rig(
     pose = cube_pose or Pose.from_rotation(CENTRE, AXIS_UP[axis])
     cube = PhysicalCube(backend, pose, config)
     segments = HOLDER_SEGMENTS[grasp]
-    holder = _load(backend, gripper_urdf("holder", "x", segments, wrist=False, pad_width=HOLDER_PAD_W), "holder")
-    rotator = _load(backend, gripper_urdf("rotator", "y", ROTATOR_SEGMENTS, wrist=True, pad_width=ROTATOR_PAD_W), "rotator")
+    holder = _load(
+        backend,
+        gripper_urdf("holder", "x", segments, wrist=False, pad_width=HOLDER_PAD_W),
+        "holder",
+    )
+    rotator = _load(
+        backend,
+        gripper_urdf("rotator", "y", ROTATOR_SEGMENTS, wrist=True, pad_width=ROTATOR_PAD_W),
+        "rotator",
+    )
     backend.set_joint_positions(holder, [HALF] * 2 * len(segments), joints=finger_joints(segments))
-    backend.set_joint_positions(rotator, [0.0, HALF, HALF], joints=["wrist"] + finger_joints(ROTATOR_SEGMENTS))
+    backend.set_joint_positions(
+        rotator, [0.0, HALF, HALF], joints=["wrist"] + finger_joints(ROTATOR_SEGMENTS)
+    )
     rig = TwistRig(backend, cube, holder, rotator, segments)
     rig.grip(holder, closed=True)
     rig.grip(rotator, closed=True)
@@ -178,7 +205,9 @@ def build_rig(
     return rig
 
 
-def twist(rig: TwistRig, angle_deg: float, intended: str | None, *, turn_s: float = 0.75, axis: str = "z") -> TwistOutcome:
+def twist(
+    rig: TwistRig, angle_deg: float, intended: str | None, *, turn_s: float = 0.75, axis: str = "z"
+) -> TwistOutcome:
     """Settle, articulate, turn the wrist by ``angle_deg`` about +z, let go of the top, end the twist."""
     cube, b = rig.cube, rig.backend
     cube.step(rig.seconds(0.05))

@@ -45,7 +45,9 @@ def test_face_axes_are_a_right_handed_frame_with_u_up():
     for a, b in ("UD", "RL", "FB"):
         assert (FACE_BODY_AXES[a] == -FACE_BODY_AXES[b]).all()
     # the core's frame (x R, y U, z F) is right-handed, so R x U = F must hold here too
-    assert np.cross(FACE_BODY_AXES["R"], FACE_BODY_AXES["U"]).tolist() == FACE_BODY_AXES["F"].tolist()
+    assert (
+        np.cross(FACE_BODY_AXES["R"], FACE_BODY_AXES["U"]).tolist() == FACE_BODY_AXES["F"].tolist()
+    )
 
 
 def test_facelets_lie_on_their_faces_and_follow_the_kociemba_net():
@@ -108,8 +110,16 @@ def test_whole_cube_rotation_is_not_a_twist():
 
 @pytest.mark.parametrize(
     "angle,k,residual,within",
-    [(89.9, 1, -0.1, True), (-90.4, -1, -0.4, True), (31.0, 0, 31.0, False), (104.0, 1, 14.0, True),
-     (-181.0, -2, -1.0, True), (44.0, 0, 44.0, False), (46.0, 1, -44.0, False), (0.0, 0, 0.0, True)],
+    [
+        (89.9, 1, -0.1, True),
+        (-90.4, -1, -0.4, True),
+        (31.0, 0, 31.0, False),
+        (104.0, 1, 14.0, True),
+        (-181.0, -2, -1.0, True),
+        (44.0, 0, 44.0, False),
+        (46.0, 1, -44.0, False),
+        (0.0, 0, 0.0, True),
+    ],
 )
 def test_snap_angle(angle, k, residual, within):
     s = snap_angle(angle, 15.0)
@@ -121,7 +131,9 @@ def test_snap_angle(angle, k, residual, within):
 def test_urdf_slabs_tile_the_cube_with_consistent_mass_and_inertia(axis):
     cfg = CubeConfig()
     root = ET.fromstring(articulated_urdf(cfg, axis))
-    masses = {l.get("name"): float(l.find("inertial/mass").get("value")) for l in root.findall("link")}
+    masses = {
+        l.get("name"): float(l.find("inertial/mass").get("value")) for l in root.findall("link")
+    }
     assert sum(masses.values()) == pytest.approx(0.094)
     assert all(m == pytest.approx(0.094 / 3) for m in masses.values())
     joints = root.findall("joint")
@@ -139,7 +151,9 @@ def test_urdf_slabs_tile_the_cube_with_consistent_mass_and_inertia(axis):
     assert np.allclose(total, rigid_inertia(cfg), rtol=1e-12)
     assert np.allclose(rigid_inertia(cfg), 0.094 * 0.057**2 / 6)
     # slabs cover [-edge/2, edge/2] along the axis without overlap
-    spans = sorted((s.centre[a] - s.size[a] / 2, s.centre[a] + s.size[a] / 2) for s in slab_geometry(cfg, axis))
+    spans = sorted(
+        (s.centre[a] - s.size[a] / 2, s.centre[a] + s.size[a] / 2) for s in slab_geometry(cfg, axis)
+    )
     assert spans[0][0] == pytest.approx(-0.0285) and spans[-1][1] == pytest.approx(0.0285)
     assert spans[0][1] == pytest.approx(spans[1][0]) and spans[1][1] == pytest.approx(spans[2][0])
 

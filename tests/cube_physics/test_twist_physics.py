@@ -9,14 +9,13 @@ import math
 
 import numpy as np
 import pytest
+from rig import CENTRE, build_rig, make_backend, twist
 
 from benchharness.backends import PhysicsConfig
 from benchharness.cube import SOLVED, apply
 from benchharness.cube_physics import CubeConfig, PhysicalCube, TwistBlockedError
 from benchharness.geometry import Pose
 from benchharness.plugin import get_manager
-
-from rig import CENTRE, build_rig, make_backend, twist
 
 BACKENDS = ["pybullet", "sapien"]
 
@@ -119,7 +118,13 @@ def test_swap_to_three_slabs_and_back_is_in_place(backend):
 def test_swap_keeps_a_flying_cubes_velocity_and_a_misaligned_layer_blocks_other_axes(name):
     b = get_manager().create("backend", name, config=PhysicsConfig(gravity=(0.0, 0.0, 0.0)))
     try:
-        cube = PhysicalCube(b, Pose([0, 0, 1.0]), CubeConfig(), linear_velocity=(0.1, 0, 0), angular_velocity=(0, 0, 0.5))
+        cube = PhysicalCube(
+            b,
+            Pose([0, 0, 1.0]),
+            CubeConfig(),
+            linear_velocity=(0.1, 0, 0),
+            angular_velocity=(0, 0, 0.5),
+        )
         b.step(2)
         lin, ang = cube.velocity()
         cube.begin_twist("z", intended="U'")
@@ -130,7 +135,9 @@ def test_swap_keeps_a_flying_cubes_velocity_and_a_misaligned_layer_blocks_other_
         out = cube.end_twist()
         assert out.misaligned and cube.misaligned and cube.articulated and out.moves == ""
         assert out.jammed  # 30° < 45°: the intended U' did not happen
-        with pytest.raises(TwistBlockedError, match="misaligned layer blocks rotation about axis x"):
+        with pytest.raises(
+            TwistBlockedError, match="misaligned layer blocks rotation about axis x"
+        ):
             cube.begin_twist("x")
         assert "misaligned layer blocks rotation about axis y" in cube.block_reason("y")
         # working the same layer on to 88° lets it snap to a quarter turn: U'

@@ -17,7 +17,10 @@ PALM_DOWN = Pose([0.0, 0.0, 0.5], Rotation.from_euler("y", 90, degrees=True).as_
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_backend_link_poses_match_fk(make_backend, make_robot, backend):
     be = make_backend(backend)
-    robot = make_robot("allegro", base_pose=Pose([0.1, 0.2, 0.4], Rotation.from_euler("xyz", [0.3, -0.5, 1.0]).as_quat()))
+    robot = make_robot(
+        "allegro",
+        base_pose=Pose([0.1, 0.2, 0.4], Rotation.from_euler("xyz", [0.3, -0.5, 1.0]).as_quat()),
+    )
     robot.spawn(be)
     check_fk_against_backend(robot, be, n=6)
 
@@ -75,7 +78,9 @@ def test_hand_mounted_on_an_arm_follows_it(make_backend, make_robot, backend):
     arm = pr2.arm("left_arm")
     tcp = arm.tcp_pose()
     res = arm.move_to_pose(Pose(tcp.p + [0.0, 0.0, 0.05], tcp.q))
-    assert res.ik_success and res.pos_error < 0.005  # the 1 kg hand is not in the arm's gravity model
+    assert (
+        res.ik_success and res.pos_error < 0.005
+    )  # the 1 kg hand is not in the arm's gravity model
     want = be.get_link_pose(pr2.body, "l_gripper_palm_link") * offset
     assert np.linalg.norm(be.get_link_pose(hand.body, None).p - want.p) < 1e-3
     assert be.get_link_pose(hand.body, None).p[2] - z0 > 0.04

@@ -30,7 +30,7 @@ def test_robots_lists_builtins_json():
 def test_inspect_json(backend):
     res = _run(["robot", "inspect", "pr2", "--backend", backend, "--json"])
     assert res.exit_code == 0, res.output
-    data = json.loads(res.output[res.output.index("{"):])
+    data = json.loads(res.output[res.output.index("{") :])
     assert data["dof"] == 19 and len(data["joints"]) == 19
     lift = next(j for j in data["joints"] if j["name"] == "l_shoulder_lift_joint")
     assert (lift["lower"], lift["upper"]) == pytest.approx((-0.5236, 1.3963))

@@ -23,7 +23,9 @@ def _root(name):
 def test_shipped_files_match_generators(tmp_path):
     for p in write_all(tmp_path):
         shipped = robots_dir() / p.parent.name / p.name
-        assert shipped.read_text() == p.read_text(), f"{shipped} is stale: run python -m benchharness.robots.descriptions"
+        assert shipped.read_text() == p.read_text(), (
+            f"{shipped} is stale: run python -m benchharness.robots.descriptions"
+        )
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -51,7 +53,11 @@ def test_inertias_are_physical(name):
         i = inertial.find("inertia")
         d = np.array([float(i.get(k)) for k in ("ixx", "iyy", "izz")])
         assert np.all(d > 0)
-        assert d[0] + d[1] >= d[2] * (1 - 1e-9) and d[1] + d[2] >= d[0] * (1 - 1e-9) and d[0] + d[2] >= d[1] * (1 - 1e-9)
+        assert (
+            d[0] + d[1] >= d[2] * (1 - 1e-9)
+            and d[1] + d[2] >= d[0] * (1 - 1e-9)
+            and d[0] + d[2] >= d[1] * (1 - 1e-9)
+        )
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -59,13 +65,18 @@ def test_every_link_and_joint_cites_a_source(name):
     lines = (robots_dir() / name / f"{name}.urdf").read_text().splitlines()
     for k, line in enumerate(lines):
         if line.startswith("  <link ") or line.startswith("  <joint "):
-            assert lines[k - 1].strip().startswith("<!--"), f"{name}.urdf line {k + 1} has no source comment"
+            assert lines[k - 1].strip().startswith("<!--"), (
+                f"{name}.urdf line {k + 1} has no source comment"
+            )
 
 
 def test_composite_inertia_matches_a_known_solid():
     """Two half boxes side by side have the inertia of the whole box (parallel-axis theorem)."""
     whole = shape_inertia(Geom("box", (0.2, 0.1, 0.05)), 2.0)
-    halves = [Geom("box", (0.1, 0.1, 0.05), (-0.05, 0, 0)), Geom("box", (0.1, 0.1, 0.05), (0.05, 0, 0))]
+    halves = [
+        Geom("box", (0.1, 0.1, 0.05), (-0.05, 0, 0)),
+        Geom("box", (0.1, 0.1, 0.05), (0.05, 0, 0)),
+    ]
     com, inertia = composite_inertia(halves, 2.0)
     np.testing.assert_allclose(com, 0, atol=1e-15)
     np.testing.assert_allclose(inertia, whole, rtol=1e-12)
@@ -92,7 +103,10 @@ def test_pr2_published_figures():
         for name in ("forearm_roll", "wrist_roll"):
             joint = j[f"{side}_{name}_joint"]
             assert joint.get("type") == "continuous"
-            assert joint.find("limit").get("lower") is None and joint.find("limit").get("upper") is None
+            assert (
+                joint.find("limit").get("lower") is None
+                and joint.find("limit").get("upper") is None
+            )
 
 
 def test_allegro_published_figures():

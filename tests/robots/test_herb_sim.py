@@ -41,9 +41,20 @@ def test_hand_grasps_and_lifts_cube(make_backend, make_robot, backend):
     arm, hand = robot.arm("left_arm"), robot.hand("left_hand")
     tcp = arm.tcp_pose()
     top = tcp.p[2] - CUBE_HALF
-    be.add_body([Box((0.02, 0.02, top / 2))], Pose([tcp.p[0], tcp.p[1], top / 2]), 1.0, fixed=True, name="pedestal")
-    cube = be.add_body([Box((CUBE_HALF,) * 3)], Pose([tcp.p[0], tcp.p[1], top + CUBE_HALF + 5e-4]), CUBE_MASS,
-                       friction=1.0, name="cube")
+    be.add_body(
+        [Box((0.02, 0.02, top / 2))],
+        Pose([tcp.p[0], tcp.p[1], top / 2]),
+        1.0,
+        fixed=True,
+        name="pedestal",
+    )
+    cube = be.add_body(
+        [Box((CUBE_HALF,) * 3)],
+        Pose([tcp.p[0], tcp.p[1], top + CUBE_HALF + 5e-4]),
+        CUBE_MASS,
+        friction=1.0,
+        name="cube",
+    )
     robot.settle(0.1)
     g = hand.close(obj=cube, timeout=1.0)
     assert g.contact and not g.closed

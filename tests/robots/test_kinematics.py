@@ -20,14 +20,27 @@ import yourdfpy
 
 from benchharness.kinematics import pose_error
 
-CHAINS = [("pr2", "left_arm"), ("pr2", "right_arm"), ("herb", "left_arm"), ("herb", "right_arm"),
-          ("allegro", "index"), ("allegro", "thumb")]
+CHAINS = [
+    ("pr2", "left_arm"),
+    ("pr2", "right_arm"),
+    ("herb", "left_arm"),
+    ("herb", "right_arm"),
+    ("allegro", "index"),
+    ("allegro", "thumb"),
+]
 
 
 @pytest.fixture(scope="module")
 def urdfs(robots):
-    return {n: yourdfpy.URDF.load(str(r.urdf_path), load_meshes=False, build_scene_graph=True,
-                                  build_collision_scene_graph=False) for n, r in robots.items()}
+    return {
+        n: yourdfpy.URDF.load(
+            str(r.urdf_path),
+            load_meshes=False,
+            build_scene_graph=True,
+            build_collision_scene_graph=False,
+        )
+        for n, r in robots.items()
+    }
 
 
 @pytest.mark.parametrize("robot,chain", CHAINS)
@@ -64,14 +77,24 @@ def test_jacobian_matches_finite_differences(robots, robot, chain):
             np.testing.assert_allclose(jac[k, 3:, i], w, atol=1e-5)
 
 
-@pytest.mark.parametrize("robot,chain,n", [("pr2", "left_arm", 200), ("pr2", "right_arm", 100), ("herb", "left_arm", 200),
-                                           ("allegro", "index", 100), ("allegro", "thumb", 100)])
+@pytest.mark.parametrize(
+    "robot,chain,n",
+    [
+        ("pr2", "left_arm", 200),
+        ("pr2", "right_arm", 100),
+        ("herb", "left_arm", 200),
+        ("allegro", "index", 100),
+        ("allegro", "thumb", 100),
+    ],
+)
 def test_ik_reaches_sampled_poses(robots, robot, chain, n):
     arm = robots[robot].arm(chain)
     q_true = arm.chain.sample(n, torch.Generator().manual_seed(11))
     targets = arm.fk(q_true)
     res = arm.ik(targets, generator=torch.Generator().manual_seed(12))
-    assert np.all(res.q >= arm.lower - 1e-9) and np.all(res.q <= arm.upper + 1e-9), "IK left the joint limits"
+    assert np.all(res.q >= arm.lower - 1e-9) and np.all(res.q <= arm.upper + 1e-9), (
+        "IK left the joint limits"
+    )
     reached = arm.fk(res.q)
     dp, dr = pose_error(reached, targets)
     ok = dp <= 1e-3
@@ -108,8 +131,11 @@ def test_gravity_torques_are_the_gradient_of_potential_energy(robots, robot):
 
     def potential(qq):
         tf = model.tree.fk(qq)
-        return -sum(model.mass[lk] * model.gravity @ (tf[lk][:3, :3] @ model.com[lk] + tf[lk][:3, 3])
-                    for lk in model.mass if lk in tf)
+        return -sum(
+            model.mass[lk] * model.gravity @ (tf[lk][:3, :3] @ model.com[lk] + tf[lk][:3, 3])
+            for lk in model.mass
+            if lk in tf
+        )
 
     tau = model.torques(q, joints)
     h = 1e-6
@@ -142,7 +168,9 @@ def test_numpy_model_matches_pytorch_kinematics(robots, robot, chain):
     tip, jac = ch._np.fk_jacobian(q)
     np.testing.assert_allclose(tip, ch._fk_pk(q), atol=1e-12)
     np.testing.assert_allclose(jac, ch.chain.jacobian(torch.as_tensor(q)).numpy(), atol=1e-12)
-    np.testing.assert_allclose(ch.fk(q[:3]), ch._fk_pk(q[:3]), atol=1e-12)  # small batch: NumPy path
+    np.testing.assert_allclose(
+        ch.fk(q[:3]), ch._fk_pk(q[:3]), atol=1e-12
+    )  # small batch: NumPy path
 
 
 @pytest.mark.parametrize("robot,chain", [("pr2", "left_arm"), ("herb", "right_arm")])
@@ -162,7 +190,9 @@ def test_seeded_ik_matches_the_restart_solver(robots, robot, chain):
     goals = np.clip(seeds + rng.normal(0.0, 0.15, seeds.shape), ch.lower, ch.upper)
     targets = ch.fk(goals)
     fast = ch.ik(targets, seed_q=seeds, seed=0)
-    slow = ch.ik(targets, seed_q=seeds, seed=0, config=replace(arm.robot.ik_config, seed_first=False))
+    slow = ch.ik(
+        targets, seed_q=seeds, seed=0, config=replace(arm.robot.ik_config, seed_first=False)
+    )
     assert fast.success.all() and slow.success.all()
     dp, dr = pose_error(ch.fk(fast.q), targets)
     assert dp.max() < 1e-4 and dr.max() < 1e-3
@@ -198,17 +228,26 @@ def test_rotation_error_matches_scipy():
 
     cur = Rotation.random(300, random_state=2)
     rng = np.random.default_rng(0)
-    cases = [Rotation.random(300, random_state=1),
-             Rotation.from_rotvec(rng.normal(0.0, 1e-9, (300, 3))) * cur,
-             Rotation.from_rotvec(np.outer(np.linspace(np.pi - 2e-3, np.pi, 300), [0.6, 0.0, 0.8])) * cur]
+    cases = [
+        Rotation.random(300, random_state=1),
+        Rotation.from_rotvec(rng.normal(0.0, 1e-9, (300, 3))) * cur,
+        Rotation.from_rotvec(np.outer(np.linspace(np.pi - 2e-3, np.pi, 300), [0.6, 0.0, 0.8]))
+        * cur,
+    ]
     for tgt in cases:
         got = _rotvec_between(tgt.as_matrix(), cur.as_matrix())
         want = (tgt * cur.inv()).as_rotvec()
-        assert (Rotation.from_rotvec(got) * Rotation.from_rotvec(want).inv()).magnitude().max() < 1e-9
-        np.testing.assert_allclose(np.linalg.norm(got, axis=1), np.linalg.norm(want, axis=1), atol=1e-9)
+        assert (
+            Rotation.from_rotvec(got) * Rotation.from_rotvec(want).inv()
+        ).magnitude().max() < 1e-9
+        np.testing.assert_allclose(
+            np.linalg.norm(got, axis=1), np.linalg.norm(want, axis=1), atol=1e-9
+        )
 
 
-@pytest.mark.parametrize("robot,chain", [("pr2", "left_arm"), ("herb", "left_arm"), ("allegro", "index")])
+@pytest.mark.parametrize(
+    "robot,chain", [("pr2", "left_arm"), ("herb", "left_arm"), ("allegro", "index")]
+)
 def test_numpy_dls_matches_pytorch_kinematics_solver(robots, robot, chain):
     """The NumPy solver (small IK passes) vs pytorch-kinematics' PseudoInverseIK from the same restarts.
 
@@ -226,8 +265,13 @@ def test_numpy_dls_matches_pytorch_kinematics_solver(robots, robot, chain):
     targets = ch.fk(ch.sample(20, _t.Generator().manual_seed(31)))
     init = ch.sample(20 * 3, _t.Generator().manual_seed(32)).reshape(20, 3, ch.dof)
     q_np, _, _, c_np = ch._dls(targets, init, cfg, cfg.max_iterations, stop_when_any=False)
-    q_pk, _, c_pk = ch._pk_solve(_t.as_tensor(targets, dtype=DTYPE), _t.as_tensor(init, dtype=DTYPE), cfg,
-                                 cfg.max_iterations, False)
+    q_pk, _, c_pk = ch._pk_solve(
+        _t.as_tensor(targets, dtype=DTYPE),
+        _t.as_tensor(init, dtype=DTYPE),
+        cfg,
+        cfg.max_iterations,
+        False,
+    )
     c_pk = c_pk.numpy()
     both = c_np & c_pk
     assert (c_np == c_pk).mean() >= 0.95 and both.sum() >= 10  # random restarts: ~40 % converge
@@ -272,8 +316,9 @@ def test_robot_gravity_feed_forward_matches_urdf_model(make_backend, make_robot,
     q = lo + np.random.default_rng(3).uniform(0.1, 0.9, len(lo)) * (hi - lo)
     be.set_joint_positions(r.body, q)
     joints = r._gravity_joints()
-    want = GravityModel(r.urdf_path, be.config.gravity).torques(dict(zip(r.joint_names, q)), joints,
-                                                                base.rotation.as_matrix())
+    want = GravityModel(r.urdf_path, be.config.gravity).torques(
+        dict(zip(r.joint_names, q)), joints, base.rotation.as_matrix()
+    )
     assert np.abs(want).max() > 1.0
     got = r._gravity_torques(joints)
     np.testing.assert_allclose(got, want, atol=1e-4 * max(1.0, np.abs(want).max()))
@@ -283,4 +328,6 @@ def test_robot_gravity_feed_forward_matches_urdf_model(make_backend, make_robot,
     be.capabilities = replace(be.capabilities, gravity_torques=False)  # this instance only
     r._gcache = None
     # (SAPIEN reports q in float32: the model sees q to ~1e-7 rad)
-    np.testing.assert_allclose(r._gravity_torques(joints), want, atol=1e-6 * max(1.0, np.abs(want).max()))
+    np.testing.assert_allclose(
+        r._gravity_torques(joints), want, atol=1e-6 * max(1.0, np.abs(want).max())
+    )

@@ -25,7 +25,9 @@ def test_builtins_registered_with_meta(manager):
 def _renamed_pr2(tmp_path):
     """A stand-in for a full pr2_description URDF: our file with its tool frames renamed."""
     text = (robots_dir() / "pr2" / "pr2.urdf").read_text()
-    text = text.replace('"l_gripper_tcp"', '"l_gripper_tool_frame"').replace('"r_gripper_tcp"', '"r_gripper_tool_frame"')
+    text = text.replace('"l_gripper_tcp"', '"l_gripper_tool_frame"').replace(
+        '"r_gripper_tcp"', '"r_gripper_tool_frame"'
+    )
     path = tmp_path / "my_pr2.urdf"
     path.write_text(text)
     return path
@@ -63,20 +65,48 @@ class ThirdPartyArm:
             cfg = RobotConfig(
                 name="allegro-finger",
                 urdf=robots_dir() / "allegro" / "allegro.urdf",
-                arms=(ArmConfig("index", ("joint_0", "joint_1", "joint_2", "joint_3"), "palm_link", "link_3_tip",
-                                (3.0,) * 4, (0.1,) * 4, position_only=True),),
-                grippers=(GripperConfig("pinch", ("joint_1", "joint_13"), ("close",), ((1.0,), (1.0,)), (0.0,),
-                                        (1.2,), ("close",), (3.0, 3.0), (0.1, 0.1), (0.7, 0.7),
-                                        ("link_3_tip", "link_15_tip"), kind="multifinger"),),
+                arms=(
+                    ArmConfig(
+                        "index",
+                        ("joint_0", "joint_1", "joint_2", "joint_3"),
+                        "palm_link",
+                        "link_3_tip",
+                        (3.0,) * 4,
+                        (0.1,) * 4,
+                        position_only=True,
+                    ),
+                ),
+                grippers=(
+                    GripperConfig(
+                        "pinch",
+                        ("joint_1", "joint_13"),
+                        ("close",),
+                        ((1.0,), (1.0,)),
+                        (0.0,),
+                        (1.2,),
+                        ("close",),
+                        (3.0, 3.0),
+                        (0.1, 0.1),
+                        (0.7, 0.7),
+                        ("link_3_tip", "link_15_tip"),
+                        kind="multifinger",
+                    ),
+                ),
             )
             return Robot(cfg)
 
-        return [Registration("allegro-finger", make, "an Allegro index finger as a robot", meta={"dof": 16})]
+        return [
+            Registration(
+                "allegro-finger", make, "an Allegro index finger as a robot", meta={"dof": 16}
+            )
+        ]
 
 
 def test_third_party_robot_plugin():
     pm = PluginManager()
-    pm.register_module(ThirdPartyArm, entry_point="third_party = my_pkg.robots", distribution="my-pkg")
+    pm.register_module(
+        ThirdPartyArm, entry_point="third_party = my_pkg.robots", distribution="my-pkg"
+    )
     assert pm.errors == []
     r = pm.create("robot", "allegro-finger")
     assert r.arm("index").fk(np.zeros(4)).shape == (1, 4, 4)

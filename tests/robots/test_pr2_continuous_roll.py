@@ -20,7 +20,9 @@ def _left_arm(robots):
 def test_roll_joints_are_continuous_and_unlimited(robots):
     arm = _left_arm(robots)
     assert list(np.flatnonzero(arm.continuous)) == [4, 6]  # forearm roll, wrist roll
-    assert np.all(np.isinf(arm.lower[arm.continuous])) and np.all(np.isinf(arm.upper[arm.continuous]))
+    assert np.all(np.isinf(arm.lower[arm.continuous])) and np.all(
+        np.isinf(arm.upper[arm.continuous])
+    )
 
 
 def test_ik_follows_the_rolls_past_pi_without_unwinding(robots):
@@ -41,13 +43,17 @@ def test_ik_follows_the_rolls_past_pi_without_unwinding(robots):
         # the 7-DOF arm is redundant, so not q_next exactly, but never a 2*pi (or any branch) jump
         assert np.max(np.abs(res.q[0] - q)) < 0.8, (q, res.q[0])
         q = res.q[0]
-    assert q[4] > 2 * np.pi - 1.5 and q[6] > 2 * np.pi + 0.5  # both went on past pi (and the wrist past 2*pi)
+    assert (
+        q[4] > 2 * np.pi - 1.5 and q[6] > 2 * np.pi + 0.5
+    )  # both went on past pi (and the wrist past 2*pi)
 
 
 def test_batched_ik_with_seeds_on_either_side_of_pi(robots):
     """Rows with different seeds (one near the +-pi seam, one not) each come back on their own branch."""
     arm = _left_arm(robots)
-    seeds = np.array([[0.05, 1.0, 0.5, -2.0, 3.1, -0.9, -3.2], [0.5, 0.6, 1.2, -1.8, 0.3, -0.5, 7.0]])
+    seeds = np.array(
+        [[0.05, 1.0, 0.5, -2.0, 3.1, -0.9, -3.2], [0.5, 0.6, 1.2, -1.8, 0.3, -0.5, 7.0]]
+    )
     goals = seeds + np.array([0.03, -0.02, 0.02, 0.03, 0.1, 0.04, -0.1])
     res = arm.ik(arm.fk(goals), seed_q=seeds)
     assert res.success.all()
@@ -86,5 +92,9 @@ def test_full_wrist_flex_is_free_of_self_collision(make_backend, make_robot, bac
             q[5], q[6] = flex, roll
             be.set_joint_positions(robot.body, q, joints=names)
             be.step(1)
-            hits = {(c.link_a, c.link_b) for c in be.contacts(robot.body, robot.body) if c.distance < 0.0}
+            hits = {
+                (c.link_a, c.link_b)
+                for c in be.contacts(robot.body, robot.body)
+                if c.distance < 0.0
+            }
             assert not hits, (flex, roll, hits)

@@ -41,7 +41,9 @@ def test_stage_puts_the_tool_where_commanded(backend):
         names = robot.joint_names
         arm = robot.arm("stage")
         for _ in range(5):
-            rot = Rotation.from_rotvec(rng.normal(0, 0.6, 3)) * Rotation.from_euler("y", 90, degrees=True)
+            rot = Rotation.from_rotvec(rng.normal(0, 0.6, 3)) * Rotation.from_euler(
+                "y", 90, degrees=True
+            )
             target = Pose.from_rotation(rng.uniform(-0.2, 0.2, 3) + [0, 0, 0.4], rot)
             q = robot.home()
             for n, v in zip(arm.joints, stage_joints_for(target)):

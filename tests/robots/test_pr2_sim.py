@@ -46,13 +46,26 @@ def test_gripper_grasps_and_lifts_cube(make_backend, make_robot, backend):
     arm, grip = robot.arm("left_arm"), robot.gripper("left_gripper")
     tcp = arm.tcp_pose()
     top = tcp.p[2] - CUBE_HALF
-    be.add_body([Box((0.02, 0.02, top / 2))], Pose([tcp.p[0], tcp.p[1], top / 2]), 1.0, fixed=True, name="pedestal")
-    cube = be.add_body([Box((CUBE_HALF,) * 3)], Pose([tcp.p[0], tcp.p[1], top + CUBE_HALF + 5e-4]), CUBE_MASS,
-                       friction=1.0, name="cube")
+    be.add_body(
+        [Box((0.02, 0.02, top / 2))],
+        Pose([tcp.p[0], tcp.p[1], top / 2]),
+        1.0,
+        fixed=True,
+        name="pedestal",
+    )
+    cube = be.add_body(
+        [Box((CUBE_HALF,) * 3)],
+        Pose([tcp.p[0], tcp.p[1], top + CUBE_HALF + 5e-4]),
+        CUBE_MASS,
+        friction=1.0,
+        name="cube",
+    )
     robot.settle(0.1)
     g = grip.close(obj=cube)
     assert g.contact and not g.closed
-    assert np.mean(g.joint_positions) == pytest.approx(CUBE_HALF - 0.001, abs=2e-3)  # pads on the faces
+    assert np.mean(g.joint_positions) == pytest.approx(
+        CUBE_HALF - 0.001, abs=2e-3
+    )  # pads on the faces
     c0 = be.get_pose(cube).p.copy()
     res = arm.move_to_pose(Pose(tcp.p + [0, 0, 0.10], tcp.q))
     assert res.ik_success

@@ -26,10 +26,24 @@ def store_path(tmp_path: Path) -> Path:
 def make_spec():
     from benchharness.runner import RunSpec, TimeBudget
 
-    def make(strategy: str = "test-drop", task: str = "Rubiks-5-5", backend: str = "pybullet", seed: int = 0,
-             budget: TimeBudget | None = None, **kw):
-        return RunSpec(task=task, robot="test-stub", strategy=strategy, backend=backend, seed=seed,
-                       plugins=(PLUGIN,), budget=budget or TimeBudget(sim_s=30.0), **kw)
+    def make(
+        strategy: str = "test-drop",
+        task: str = "Rubiks-5-5",
+        backend: str = "pybullet",
+        seed: int = 0,
+        budget: TimeBudget | None = None,
+        **kw,
+    ):
+        return RunSpec(
+            task=task,
+            robot="test-stub",
+            strategy=strategy,
+            backend=backend,
+            seed=seed,
+            plugins=(PLUGIN,),
+            budget=budget or TimeBudget(sim_s=30.0),
+            **kw,
+        )
 
     return make
 

@@ -94,9 +94,11 @@ class TimedStrategy:
         ctx.recorder.contact()
         steps = round(ctx.item.trial / ctx.physics.timestep)
         ctx.backend.step(steps)
-        return TrialOutcome(final_state=expected_final(ctx.item.sequence, ctx.item.initial),
-                            termination_s=ctx.sim_start + steps * ctx.physics.timestep,
-                            first_contact_s=ctx.sim_start)
+        return TrialOutcome(
+            final_state=expected_final(ctx.item.sequence, ctx.item.initial),
+            termination_s=ctx.sim_start + steps * ctx.physics.timestep,
+            first_contact_s=ctx.sim_start,
+        )
 
 
 class SimErrorStrategy:
@@ -119,7 +121,7 @@ class SlowSimStrategy:
         while True:
             try:
                 ctx.backend.step(24)
-            except Exception:  # a careless strategy: must not swallow the timeout
+            except Exception:  # noqa: BLE001 - a careless strategy: must not swallow the timeout
                 pass
 
 
@@ -183,4 +185,7 @@ def benchharness_sensors():
 
 @hookimpl
 def benchharness_strategies():
-    return [Registration(name, cls, f"test-only: {cls.__doc__ or name}".splitlines()[0]) for name, cls in STRATEGIES.items()]
+    return [
+        Registration(name, cls, f"test-only: {cls.__doc__ or name}".splitlines()[0])
+        for name, cls in STRATEGIES.items()
+    ]

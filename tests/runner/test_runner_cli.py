@@ -16,8 +16,11 @@ PLUGIN = "runner_testplugins"  # tests/runner/runner_testplugins.py
 
 
 def backends_wanted() -> set[str] | None:
-    wanted = {b.strip() for b in os.environ.get("BENCHHARNESS_BACKENDS", "").split(",") if b.strip()}
+    wanted = {
+        b.strip() for b in os.environ.get("BENCHHARNESS_BACKENDS", "").split(",") if b.strip()
+    }
     return wanted or None
+
 
 pytestmark = pytest.mark.sim
 
@@ -25,7 +28,7 @@ BASE = ["--robot", "test-stub", "--plugin", PLUGIN, "--workers", "0", "--no-prog
 
 
 def _json(result):
-    return json.loads(result.output[result.output.index("{"):])
+    return json.loads(result.output[result.output.index("{") :])
 
 
 def test_table_shows_hand_computed_mean_and_std_beside_the_paper(invoke):
@@ -65,8 +68,12 @@ def test_partial_tier_is_not_shown_as_a_score(invoke):
 
 
 def test_bad_names_exit_2_with_the_plugin_managers_message(invoke):
-    for opt, value, kind in (("--robot", "nope", "robot"), ("--strategy", "nope", "strategy"),
-                             ("--backend", "nope", "backend"), ("--sensors", "a,nope", "sensor")):
+    for opt, value, kind in (
+        ("--robot", "nope", "robot"),
+        ("--strategy", "nope", "strategy"),
+        ("--backend", "nope", "backend"),
+        ("--sensors", "a,nope", "sensor"),
+    ):
         args = ["--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE]
         if opt in args:
             args[args.index(opt) + 1] = value
@@ -90,7 +97,10 @@ def test_results_lists_failures_with_causes(invoke):
     assert any("SimulationError" in t["traceback"] for t in data)
     text = invoke(results).output
     assert "simulator_error" in text and "jammed" in text and "success" in text
-    assert invoke(results, "--strategy", "test-drop", "--json").output.count('"status": "success"') == 1
+    assert (
+        invoke(results, "--strategy", "test-drop", "--json").output.count('"status": "success"')
+        == 1
+    )
 
 
 def test_pose_error_plot(invoke, tmp_path):
@@ -104,14 +114,26 @@ def test_pose_error_plot(invoke, tmp_path):
 def test_video_mp4_and_a_clear_error_without_a_camera(invoke, tmp_path):
     pytest.importorskip("imageio_ffmpeg")
     mp4 = tmp_path / "trial.mp4"
-    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--video", str(mp4), "--json")
+    r = invoke(
+        run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--video", str(mp4), "--json"
+    )
     assert r.exit_code == 0, r.output
     info = _json(r)["video"]
     # the trial lasts ~0.3 simulated s: frames at 30 per simulated second
     assert 5 <= info["frames"] <= 15 and mp4.stat().st_size > 1000
     assert mp4.read_bytes()[4:8] == b"ftyp"
-    r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backend", "sapien",
-               "--video", str(tmp_path / "x.mp4"))
+    r = invoke(
+        run,
+        "--task",
+        "Rubiks-1-5",
+        "--strategy",
+        "test-drop",
+        *BASE,
+        "--backend",
+        "sapien",
+        "--video",
+        str(tmp_path / "x.mp4"),
+    )
     assert r.exit_code == 2 and "has no camera" in r.output
 
 
@@ -122,7 +144,17 @@ def test_gif_video(invoke, tmp_path):
 
 
 def test_inhand_run_and_tables(invoke):
-    r = invoke(run, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "5", *BASE, "--json")
+    r = invoke(
+        run,
+        "--task",
+        "inhand-level3-dmg",
+        "--strategy",
+        "test-inhand",
+        "--repeats",
+        "5",
+        *BASE,
+        "--json",
+    )
     trials = _json(r)["trials"]
     assert len(trials) == 20 and r.exit_code == 1  # some drops
     drops = sum(t["failure_cause"] == "dropped" for t in trials)
@@ -132,19 +164,37 @@ def test_inhand_run_and_tables(invoke):
     assert ours[0]["drops_percent"] == pytest.approx(100 * drops / 20)
     scores = [t["score"] for t in trials if t["status"] == "success"]
     assert ours[0]["err_pos_cm"] == pytest.approx(100 * float(np.median(scores)))
-    assert {row["method"] for row in data["table2"] if row["source"] == "paper"} >= {"relaxed-rigidity"}
+    assert {row["method"] for row in data["table2"] if row["source"] == "paper"} >= {
+        "relaxed-rigidity"
+    }
     t3 = data["table3"]
-    assert {row["object"] for row in t3} == {"gelatin box", "cracker box", "spatula", "potted meat can"}
+    assert {row["object"] for row in t3} == {
+        "gelatin box",
+        "cracker box",
+        "spatula",
+        "potted meat can",
+    }
     assert all(row["paper"]["err_pos_cm"] > 0 for row in t3)
     text = invoke(table, "--benchmark", "inhand").output
     assert "relaxed-rigidity" in text and "gelatin box [gelatin_box-dmg2]" in text
 
 
-@pytest.mark.skipif(backends_wanted() is not None and not {"pybullet", "sapien"} <= backends_wanted(),
-                    reason="needs both backends")
+@pytest.mark.skipif(
+    backends_wanted() is not None and not {"pybullet", "sapien"} <= backends_wanted(),
+    reason="needs both backends",
+)
 def test_compare_runs_the_tier_on_both_backends(invoke):
-    r = invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backends", "pybullet,sapien",
-               "--json")
+    r = invoke(
+        compare,
+        "--task",
+        "Rubiks-1-5",
+        "--strategy",
+        "test-drop",
+        *BASE,
+        "--backends",
+        "pybullet,sapien",
+        "--json",
+    )
     assert r.exit_code == 0, r.output
     data = _json(r)
     assert set(data["summary"]) == {"pybullet", "sapien"}
@@ -154,11 +204,25 @@ def test_compare_runs_the_tier_on_both_backends(invoke):
         assert not math.isnan(row[b]["score"])
     text = invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE).output
     assert "pybullet: status" in text and "sapien: status" in text and "real-time factor" in text
-    assert invoke(compare, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--backends", "pybullet").exit_code == 2
+    assert (
+        invoke(
+            compare,
+            "--task",
+            "Rubiks-1-5",
+            "--strategy",
+            "test-drop",
+            *BASE,
+            "--backends",
+            "pybullet",
+        ).exit_code
+        == 2
+    )
 
 
 def test_inhand_figure7_plot_and_compare_summary(invoke, tmp_path):
-    r = invoke(run, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "3", *BASE)
+    r = invoke(
+        run, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "3", *BASE
+    )
     png = tmp_path / "fig7.png"
     r = invoke(table, "--benchmark", "inhand", "--plot", str(png), "--json")
     assert r.exit_code == 0, r.output
@@ -175,7 +239,10 @@ def test_inhand_figure7_plot_and_compare_summary(invoke, tmp_path):
         # the medians are those of the stored trials of that backend (Table II's own computation)
         ok = [t[b] for t in data["trials"] if t[b]["status"] == "success"]
         assert v["err_pos_cm"] == pytest.approx(100 * float(np.median([t["score"] for t in ok])))
-    assert "Table II layout" in invoke(compare, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", *BASE).output
+    assert (
+        "Table II layout"
+        in invoke(compare, "--task", "inhand-level3-dmg", "--strategy", "test-inhand", *BASE).output
+    )
 
 
 def test_table_plot_without_inhand_trials_is_a_clear_error(invoke, tmp_path):
@@ -199,7 +266,11 @@ def test_table3_contact_rows_come_from_the_scorer_and_only_for_successes(invoke,
     rows = inhand_table3(trials, contact_scorer=scorer)
     assert set(seen) == {"success"}
     for r in rows:
-        ok = [t.outcome["repeat"] for t in trials if t.outcome["task_id"] == r["task_id"] and t.status.value == "success"]
+        ok = [
+            t.outcome["repeat"]
+            for t in trials
+            if t.outcome["task_id"] == r["task_id"] and t.status.value == "success"
+        ]
         want = float(np.median(ok)) if ok else None
         assert r["ours"]["g_euc_cm"] == (pytest.approx(want) if ok else None)
         assert r["ours"]["g_geo_cm"] == (pytest.approx(2.0) if ok else None)
@@ -216,13 +287,22 @@ def test_one_method_is_one_column_across_tiers_with_their_own_default_budgets(in
     assert labels == {"test-timed (test-stub, pybullet)"}
     # the same tier run again with other options is a different run: then the method splits by options
     # hash (one column per distinct hash: the store cannot tell a default budget from a chosen one)
-    assert invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE, "--sim-budget", "500").exit_code == 0
+    assert (
+        invoke(
+            run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE, "--sim-budget", "500"
+        ).exit_code
+        == 0
+    )
     data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
     labels = {lab for row in data["rows"] for lab in row["ours"]}
-    assert len(labels) == 3 and all(lab.startswith("test-timed (test-stub, pybullet) options ") for lab in labels)
+    assert len(labels) == 3 and all(
+        lab.startswith("test-timed (test-stub, pybullet) options ") for lab in labels
+    )
 
 
-def test_a_sweep_straddling_a_commit_is_one_column_and_a_rerun_at_another_commit_splits(invoke, monkeypatch):
+def test_a_sweep_straddling_a_commit_is_one_column_and_a_rerun_at_another_commit_splits(
+    invoke, monkeypatch
+):
     from benchharness.runner.spec import code_version
 
     def at(version: str) -> None:
@@ -233,18 +313,24 @@ def test_a_sweep_straddling_a_commit_is_one_column_and_a_rerun_at_another_commit
         at("0.1.0+gaaaa")
         assert invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE).exit_code == 0
         at("0.1.0+gbbbb")
-        assert invoke(run, "--task", "Rubiks-1-10", "--strategy", "test-timed", *BASE).exit_code == 0
+        assert (
+            invoke(run, "--task", "Rubiks-1-10", "--strategy", "test-timed", *BASE).exit_code == 0
+        )
         res = invoke(table, "--run-tiers")
         data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
         assert [c["code_version"] for c in data["columns"]] == ["0.1.0+gaaaa, 0.1.0+gbbbb"]
-        assert {lab for row in data["rows"] for lab in row["ours"]} == {"test-timed (test-stub, pybullet)"}
+        assert {lab for row in data["rows"] for lab in row["ours"]} == {
+            "test-timed (test-stub, pybullet)"
+        }
         assert "runs from code versions 0.1.0+gaaaa, 0.1.0+gbbbb" in res.output
         # the same tier again at a third commit: that method's runs split by code version
         at("0.1.0+gcccc")
         assert invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-timed", *BASE).exit_code == 0
         data = _json(invoke(table, "--json", "--run-tiers"))["rubiks"]
         labels = {lab for row in data["rows"] for lab in row["ours"]}
-        assert labels == {f"test-timed (test-stub, pybullet) code 0.1.0+g{v}" for v in ("aaaa", "bbbb", "cccc")}
+        assert labels == {
+            f"test-timed (test-stub, pybullet) code 0.1.0+g{v}" for v in ("aaaa", "bbbb", "cccc")
+        }
     finally:
         monkeypatch.delenv("BENCHHARNESS_CODE_VERSION")
         code_version.cache_clear()

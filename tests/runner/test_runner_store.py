@@ -6,20 +6,54 @@ import sqlite3
 
 import pytest
 
-from benchharness.runner import FailureCause, ResultsStore, RunSpec, TrialRecord, TrialStatus, default_store_path
+from benchharness.runner import (
+    FailureCause,
+    ResultsStore,
+    RunSpec,
+    TrialRecord,
+    TrialStatus,
+    default_store_path,
+)
 from benchharness.runner.store import SCHEMA_VERSION, StoreError
 
 
 def _spec(**kw) -> RunSpec:
-    return RunSpec(task="Rubiks-5-5", robot="pr2", strategy="dead-reckoning", backend="pybullet", **kw)
+    return RunSpec(
+        task="Rubiks-5-5", robot="pr2", strategy="dead-reckoning", backend="pybullet", **kw
+    )
 
 
 def _rec(spec: RunSpec, i: int, ok: bool = True) -> TrialRecord:
     if ok:
-        return TrialRecord(spec.run_key, i, TrialStatus.SUCCESS, 10.0 + i, None, "", 0.5, 20.0, 1.0, 11.0 + i,
-                           {"final_state": "x"}, {"events": [{"kind": "move", "t": 1.5}]})
-    return TrialRecord(spec.run_key, i, TrialStatus.FAILURE, None, FailureCause.WRONG_STATE, "differs", 0.5,
-                       float("nan"), None, None, {}, {}, "Traceback ...")
+        return TrialRecord(
+            spec.run_key,
+            i,
+            TrialStatus.SUCCESS,
+            10.0 + i,
+            None,
+            "",
+            0.5,
+            20.0,
+            1.0,
+            11.0 + i,
+            {"final_state": "x"},
+            {"events": [{"kind": "move", "t": 1.5}]},
+        )
+    return TrialRecord(
+        spec.run_key,
+        i,
+        TrialStatus.FAILURE,
+        None,
+        FailureCause.WRONG_STATE,
+        "differs",
+        0.5,
+        float("nan"),
+        None,
+        None,
+        {},
+        {},
+        "Traceback ...",
+    )
 
 
 def test_schema_version_and_wal(store_path):
@@ -29,13 +63,32 @@ def test_schema_version_and_wal(store_path):
     assert con.execute("SELECT version FROM schema_version").fetchall() == [(SCHEMA_VERSION,)]
     assert con.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
     cols = [r[1] for r in con.execute("PRAGMA table_info(trials)")]
-    for c in ("run_key", "task", "robot", "strategy", "sensors", "backend", "seed", "physics_hash", "code_version",
-              "trial_index", "status", "score", "failure_cause", "wall_s", "sim_s", "diagnostics_json"):
+    for c in (
+        "run_key",
+        "task",
+        "robot",
+        "strategy",
+        "sensors",
+        "backend",
+        "seed",
+        "physics_hash",
+        "code_version",
+        "trial_index",
+        "status",
+        "score",
+        "failure_cause",
+        "wall_s",
+        "sim_s",
+        "diagnostics_json",
+    ):
         assert c in cols
     con.close()
     with ResultsStore(store_path):  # reopening does not add a second version row
         pass
-    assert sqlite3.connect(store_path).execute("SELECT count(*) FROM schema_version").fetchone()[0] == 1
+    assert (
+        sqlite3.connect(store_path).execute("SELECT count(*) FROM schema_version").fetchone()[0]
+        == 1
+    )
 
 
 def test_newer_schema_is_refused(store_path):
@@ -77,14 +130,26 @@ def test_rows_roundtrip_and_resume_bookkeeping(store_path):
         rows = store.trials(run_key=spec.run_key)
     assert [r.trial_index for r in rows] == [1, 2]
     ok, bad = rows
-    assert ok.status is TrialStatus.SUCCESS and ok.score == 11.0 and ok.diagnostics["events"][0]["kind"] == "move"
-    assert (ok.task, ok.robot, ok.strategy, ok.backend, ok.seed) == ("Rubiks-5-5", "pr2", "dead-reckoning", "pybullet", 0)
+    assert (
+        ok.status is TrialStatus.SUCCESS
+        and ok.score == 11.0
+        and ok.diagnostics["events"][0]["kind"] == "move"
+    )
+    assert (ok.task, ok.robot, ok.strategy, ok.backend, ok.seed) == (
+        "Rubiks-5-5",
+        "pr2",
+        "dead-reckoning",
+        "pybullet",
+        0,
+    )
     assert ok.physics_hash == spec.physics_hash and ok.code_version == spec.code
     assert bad.failure_cause is FailureCause.WRONG_STATE and bad.sim_s is None and bad.traceback
     with ResultsStore(store_path) as store:  # a second connection sees what the first committed
         assert store.count(spec.run_key) == 2
         assert [r.trial_index for r in store.trials(failures_only=True)] == [2]
-        assert store.trials(task="rubiks-5-5", strategy=["dead-reckoning"]) and not store.trials(backend="sapien")
+        assert store.trials(task="rubiks-5-5", strategy=["dead-reckoning"]) and not store.trials(
+            backend="sapien"
+        )
 
 
 def test_write_needs_the_run(store_path):

@@ -74,13 +74,34 @@ def _count(path) -> int:
 
 
 def test_killed_sweep_resumes_where_it_stopped(store_path):
-    args = ["--task", "Rubiks-5-5", "--robot", "test-stub", "--strategy", "test-drop", "--plugin", PLUGIN,
-            "--workers", "1", "--store", str(store_path), "--json", "--no-progress"]
+    args = [
+        "--task",
+        "Rubiks-5-5",
+        "--robot",
+        "test-stub",
+        "--strategy",
+        "test-drop",
+        "--plugin",
+        PLUGIN,
+        "--workers",
+        "1",
+        "--store",
+        str(store_path),
+        "--json",
+        "--no-progress",
+    ]
     code = "import sys; from benchharness.cli.run import run; run(sys.argv[1:])"
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]))
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")])
+    )
     slow = dict(env, RUNNER_TEST_SLEEP="0.6")
-    proc = subprocess.Popen([sys.executable, "-c", code, *args], env=slow, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, *args],
+        env=slow,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     try:
         deadline = time.monotonic() + 60
         while _count(store_path) < 2 and time.monotonic() < deadline and proc.poll() is None:
@@ -93,11 +114,13 @@ def test_killed_sweep_resumes_where_it_stopped(store_path):
     with ResultsStore(store_path) as store:
         before = {t.trial_index: t.finished_at for t in store.trials()}
     resume = [a if a != "1" else "0" for a in args]  # --workers is not part of the run key
-    out = subprocess.run([sys.executable, "-c", code, *resume], env=env, capture_output=True, text=True, timeout=120)
+    out = subprocess.run(
+        [sys.executable, "-c", code, *resume], env=env, capture_output=True, text=True, timeout=120
+    )
     assert out.returncode == 0, out.stderr
     import json
 
-    data = json.loads(out.stdout[out.stdout.index("{"):])
+    data = json.loads(out.stdout[out.stdout.index("{") :])
     assert data["ran"] == 5 - done and data["skipped"] == sorted(before)
     with ResultsStore(store_path) as store:
         rows = store.trials()

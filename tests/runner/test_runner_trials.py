@@ -20,9 +20,19 @@ pytestmark = pytest.mark.sim
     "strategy, status, cause, text",
     [
         ("test-drop", TrialStatus.SUCCESS, None, ""),
-        ("test-wrong", TrialStatus.FAILURE, FailureCause.WRONG_STATE, "differs from the expected one"),
+        (
+            "test-wrong",
+            TrialStatus.FAILURE,
+            FailureCause.WRONG_STATE,
+            "differs from the expected one",
+        ),
         ("test-simerror", TrialStatus.FAILURE, FailureCause.SIMULATOR_ERROR, "became NaN"),
-        ("test-crash", TrialStatus.FAILURE, FailureCause.STRATEGY_ERROR, "ValueError: bug in the strategy"),
+        (
+            "test-crash",
+            TrialStatus.FAILURE,
+            FailureCause.STRATEGY_ERROR,
+            "ValueError: bug in the strategy",
+        ),
         ("test-slowsim", TrialStatus.FAILURE, FailureCause.TIMEOUT, "simulated-time budget of 2 s"),
         ("test-jammed", TrialStatus.FAILURE, FailureCause.JAMMED, "twist 1 jammed"),
         ("test-notoutcome", TrialStatus.FAILURE, FailureCause.STRATEGY_ERROR, "not TrialOutcome"),
@@ -132,7 +142,9 @@ def test_inhand_trials_are_scored_by_score_trials(make_spec):
     assert dropped and ok and len(dropped) + len(ok) == 12
     for r in ok:
         o = r.outcome
-        s = score_trials(np.array([o["initial"]]), np.array([o["desired"]]), np.array([o["reached"]]))
+        s = score_trials(
+            np.array([o["initial"]]), np.array([o["desired"]]), np.array([o["reached"]])
+        )
         assert r.score == pytest.approx(float(s.err_pos[0]))
         assert o["metrics"]["err_pos_percent"] == pytest.approx(float(s.err_pos_percent[0]))
     assert all(r.score is None and r.outcome["dropped"] for r in dropped)
@@ -147,5 +159,7 @@ def test_sensors_are_slots_with_their_own_streams(make_spec):
     err = lambda r: max(e["pos_err_m"] for e in r.diagnostics["pose_estimates"])  # noqa: E731
     assert err(a) < err(blind)
     # the strategy's own stream does not depend on how many sensors there are
-    assert (trial_streams(0, "Rubiks-1-10", 1, 0).strategy.random(4).tolist()
-            == trial_streams(0, "Rubiks-1-10", 1, 3).strategy.random(4).tolist())
+    assert (
+        trial_streams(0, "Rubiks-1-10", 1, 0).strategy.random(4).tolist()
+        == trial_streams(0, "Rubiks-1-10", 1, 3).strategy.random(4).tolist()
+    )

@@ -64,7 +64,9 @@ class CubeRig:
         return self.backend.get_pose(self.cube)
 
 
-def cube_rig(backend: Backend, yaw_deg: float = 10.0, emitters=FINGER_EMITTERS, tof=None) -> CubeRig:
+def cube_rig(
+    backend: Backend, yaw_deg: float = 10.0, emitters=FINGER_EMITTERS, tof=None
+) -> CubeRig:
     g = backend.add_ground(0.0)
     pose = Pose.from_rotation(CUBE_CENTRE, Rotation.from_euler("z", yaw_deg, degrees=True))
     cube = backend.add_body([Box((HALF,) * 3)], pose, 0.094, name="cube")
@@ -73,8 +75,9 @@ def cube_rig(backend: Backend, yaw_deg: float = 10.0, emitters=FINGER_EMITTERS, 
     return CubeRig(backend, g, cube, sb, sensor)
 
 
-def offset_prior(truth: Pose, rng: np.random.Generator, pos_err: float = 0.008,
-                 yaw_err_deg: float = 5.0) -> PoseEstimate:
+def offset_prior(
+    truth: Pose, rng: np.random.Generator, pos_err: float = 0.008, yaw_err_deg: float = 5.0
+) -> PoseEstimate:
     """A head-camera estimate forced to be ``pos_err`` m and ``yaw_err_deg`` off (direction from ``rng``).
 
     Its covariance is the camera's shape, scaled so the forced error is ~1.5σ
@@ -88,7 +91,9 @@ def offset_prior(truth: Pose, rng: np.random.Generator, pos_err: float = 0.008,
     std = np.sqrt(np.diag(HeadCamera().covariance))
     std[:3] = pos_err / (1.5 * np.sqrt(3.0))
     std[5] = np.deg2rad(yaw_err_deg) / 1.5
-    return PoseEstimate(pose, np.diag(std**2), n_measurements=1, axes=CAMERA_AXES, source="head-camera")
+    return PoseEstimate(
+        pose, np.diag(std**2), n_measurements=1, axes=CAMERA_AXES, source="head-camera"
+    )
 
 
 def two_face_scan(rig: CubeRig, prior: PoseEstimate, rng: np.random.Generator, faces=("-x", "-y")):

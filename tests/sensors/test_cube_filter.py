@@ -15,10 +15,10 @@ from scipy.spatial.transform import Rotation
 
 pytest.importorskip("filterpy")
 
-from filterpy.kalman import ExtendedKalmanFilter  # noqa: E402
+from filterpy.kalman import ExtendedKalmanFilter
 
-from benchharness.geometry import Pose  # noqa: E402
-from benchharness.sensors import (  # noqa: E402
+from benchharness.geometry import Pose
+from benchharness.sensors import (
     CAMERA_AXES,
     FILTER_AXES,
     CubeFilterConfig,
@@ -36,9 +36,15 @@ TRUE_YAW = math.radians(12.0)
 
 
 def _prior(dp=(0.004, -0.005, 0.002), dyaw_deg=4.0) -> PoseEstimate:
-    pose = Pose.from_rotation(TRUE_P + np.asarray(dp), Rotation.from_euler("z", TRUE_YAW + math.radians(dyaw_deg)))
-    return PoseEstimate(pose, np.diag([0.004**2, 0.004**2, 0.003**2, 1e-4, 1e-4, math.radians(3.0) ** 2]),
-                        n_measurements=1, axes=CAMERA_AXES)
+    pose = Pose.from_rotation(
+        TRUE_P + np.asarray(dp), Rotation.from_euler("z", TRUE_YAW + math.radians(dyaw_deg))
+    )
+    return PoseEstimate(
+        pose,
+        np.diag([0.004**2, 0.004**2, 0.003**2, 1e-4, 1e-4, math.radians(3.0) ** 2]),
+        n_measurements=1,
+        axes=CAMERA_AXES,
+    )
 
 
 def _synthetic_scan(prior: PoseEstimate, rng, noise=0.0015):
@@ -72,7 +78,9 @@ def test_state_shapes_survive_filterpy_2():
     assert kf._kf.x.shape == (4, 1)
     est = kf.estimate
     assert est.covariance.shape == (4, 4) and est.axes == FILTER_AXES
-    assert np.allclose(est.covariance, est.covariance.T) and np.all(np.linalg.eigvalsh(est.covariance) > 0)
+    assert np.allclose(est.covariance, est.covariance.T) and np.all(
+        np.linalg.eigvalsh(est.covariance) > 0
+    )
 
 
 def test_the_filterpy_gotcha_is_real():
@@ -132,7 +140,12 @@ def test_dead_reckoning_covariance_grows_with_commanded_motion():
 
     still, short, long_ = after([0, 0, 0]), after([0.01, 0, 0]), after([0.2, 0, 0])
     p0 = CubePoseFilter(initial=_prior()).P
-    assert np.trace(p0[:3, :3]) < np.trace(still.P[:3, :3]) < np.trace(short.P[:3, :3]) < np.trace(long_.P[:3, :3])
+    assert (
+        np.trace(p0[:3, :3])
+        < np.trace(still.P[:3, :3])
+        < np.trace(short.P[:3, :3])
+        < np.trace(long_.P[:3, :3])
+    )
     turned = after([0, 0, 0], math.radians(90))
     assert turned.P[3, 3] > still.P[3, 3]
     # the mean moves by exactly the commanded displacement: dead reckoning trusts it
@@ -161,19 +174,26 @@ def test_predict_carried_rotates_about_the_gripper():
     kf2 = CubePoseFilter(initial=_prior(dp=(0, 0, 0), dyaw_deg=0.0))
     p_before = kf2.P[3, 3]
     axis = Rotation.from_euler("z", TRUE_YAW).apply([1.0, 0.0, 0.0])
-    tilt = kf2.predict_carried(Pose(TRUE_P), Pose.from_rotation(TRUE_P, Rotation.from_rotvec(axis * math.pi / 2)))
+    tilt = kf2.predict_carried(
+        Pose(TRUE_P), Pose.from_rotation(TRUE_P, Rotation.from_rotvec(axis * math.pi / 2))
+    )
     assert tilt == pytest.approx(0.0, abs=1e-9)
     assert math.degrees(kf2.x[3]) == pytest.approx(12.0, abs=1e-9)
     assert kf2.P[3, 3] - p_before == pytest.approx(kf2.process_noise(0.0, math.pi / 2)[3, 3])
     # the same flip about world x tilts a yawed box by its yaw: reported, since the state cannot hold it
     kf3 = CubePoseFilter(initial=_prior(dp=(0, 0, 0), dyaw_deg=0.0))
-    tilt = kf3.predict_carried(Pose(TRUE_P), Pose.from_rotation(TRUE_P, Rotation.from_euler("x", 90, degrees=True)))
+    tilt = kf3.predict_carried(
+        Pose(TRUE_P), Pose.from_rotation(TRUE_P, Rotation.from_euler("x", 90, degrees=True))
+    )
     assert math.degrees(tilt) == pytest.approx(12.0)
 
 
 def test_yaw_wraps_at_45_degrees():
-    prior = PoseEstimate(Pose.from_rotation(TRUE_P, Rotation.from_euler("z", 44, degrees=True)),
-                         np.diag([1e-6, 1e-6, 1e-6, 1e-3]), axes=FILTER_AXES)
+    prior = PoseEstimate(
+        Pose.from_rotation(TRUE_P, Rotation.from_euler("z", 44, degrees=True)),
+        np.diag([1e-6, 1e-6, 1e-6, 1e-3]),
+        axes=FILTER_AXES,
+    )
     kf = CubePoseFilter(initial=prior)
     kf.predict(delta_yaw=math.radians(3))
     assert math.degrees(kf.x[3]) == pytest.approx(-43.0)
@@ -199,8 +219,11 @@ def test_initialise_from_head_camera_estimate():
 
 def test_a_zero_variance_prior_is_not_moved():
     """A perfectly known pose stays put under any ranges (and nothing divides by zero)."""
-    prior = PoseEstimate(Pose.from_rotation(TRUE_P, Rotation.from_euler("z", TRUE_YAW)), np.zeros((4, 4)),
-                         axes=FILTER_AXES)
+    prior = PoseEstimate(
+        Pose.from_rotation(TRUE_P, Rotation.from_euler("z", TRUE_YAW)),
+        np.zeros((4, 4)),
+        axes=FILTER_AXES,
+    )
     kf = CubePoseFilter(initial=prior)
     o, d, z = _synthetic_scan(_prior(), np.random.default_rng(4))
     kf.update_ranges(o, d, z + 0.002)

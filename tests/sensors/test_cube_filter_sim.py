@@ -15,11 +15,7 @@ from scipy.stats import chi2
 
 pytest.importorskip("filterpy")
 
-from benchharness.backends import Box  # noqa: E402
-from benchharness.geometry import Pose  # noqa: E402
-from benchharness.sensors import FILTER_AXES, CubePoseFilter, HeadCamera  # noqa: E402
-
-from sensor_rig import (  # noqa: E402
+from sensor_rig import (
     BACKENDS,
     CUBE_CENTRE,
     HALF,
@@ -29,6 +25,10 @@ from sensor_rig import (  # noqa: E402
     offset_prior,
     two_face_scan,
 )
+
+from benchharness.backends import Box
+from benchharness.geometry import Pose
+from benchharness.sensors import FILTER_AXES, CubePoseFilter, HeadCamera
 
 pytestmark = pytest.mark.sim
 
@@ -64,8 +64,10 @@ def test_two_face_sweep_relocalises_the_cube(backend, yaw_deg):
         assert np.all(np.abs(e) <= 3.5 * np.sqrt(np.diag(est.covariance)))
         assert rep.n_used >= 60 and est.n_measurements == 1 + rep.n_used
         assert est.time == pytest.approx(backend.time)
-    print(f"{backend.name} yaw {yaw_deg}: worst position error {worst_p * 1e3:.2f} mm, "
-          f"yaw {math.degrees(worst_y):.2f}°")
+    print(
+        f"{backend.name} yaw {yaw_deg}: worst position error {worst_p * 1e3:.2f} mm, "
+        f"yaw {math.degrees(worst_y):.2f}°"
+    )
 
 
 def test_a_body_in_the_way_is_gated(backend):
@@ -73,7 +75,9 @@ def test_a_body_in_the_way_is_gated(backend):
     rig = cube_rig(backend, 10.0)
     truth = rig.truth
     face_pt = truth.apply([-HALF - 0.01, -0.015, 0.0])
-    plate = backend.add_body([Box((0.001, 0.006, 0.02))], Pose(face_pt, truth.q), 0.01, fixed=True, name="finger")
+    plate = backend.add_body(
+        [Box((0.001, 0.006, 0.02))], Pose(face_pt, truth.q), 0.01, fixed=True, name="finger"
+    )
     rng = np.random.default_rng(7)
     prior = offset_prior(truth, rng, pos_err=0.005, yaw_err_deg=3.0)
     kf = CubePoseFilter(initial=prior)
@@ -104,7 +108,9 @@ def test_filter_is_consistent_over_seeded_runs(backend):
         nees[k] = e @ np.linalg.solve(est.covariance, e)
         inside += bool(np.all(np.abs(e) <= 3 * np.sqrt(np.diag(est.covariance))))
     lo, hi = chi2.ppf([0.005, 0.995], 4 * runs) / runs  # 99 % interval of the mean NEES
-    print(f"{backend.name}: mean NEES {nees.mean():.2f} (99 % interval {lo:.2f}-{hi:.2f}), within 3σ {inside}/{runs}")
+    print(
+        f"{backend.name}: mean NEES {nees.mean():.2f} (99 % interval {lo:.2f}-{hi:.2f}), within 3σ {inside}/{runs}"
+    )
     assert lo <= nees.mean() <= hi
     assert inside >= 0.95 * runs - 1e-9 or inside >= runs - 1
 

@@ -5,12 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from sensor_rig import BACKENDS, new_backend
 
 from benchharness.backends import Box, Sphere
 from benchharness.geometry import Pose
 from benchharness.sensors import Emitter, PreTouchSensor, ToFConfig, free_body_mover, scan
-
-from sensor_rig import BACKENDS, new_backend
 
 pytestmark = pytest.mark.sim
 
@@ -26,13 +25,17 @@ def backend(request):
 
 def _wall(b):
     """A large fixed slab whose -x face is the plane x = WALL_X."""
-    return b.add_body([Box((0.01, 0.3, 0.3))], Pose([WALL_X + 0.01, 0.0, 0.3]), 1.0, fixed=True, name="wall")
+    return b.add_body(
+        [Box((0.01, 0.3, 0.3))], Pose([WALL_X + 0.01, 0.0, 0.3]), 1.0, fixed=True, name="wall"
+    )
 
 
 def _grid_emitters(n_side: int = 20) -> list[Emitter]:
     """n_side² parallel emitters on a 2 mm grid, all looking along link +x."""
     ys, zs = np.meshgrid(np.arange(n_side) * 0.002, np.arange(n_side) * 0.002)
-    return [Emitter((0.0, float(y), float(z)), (1.0, 0.0, 0.0)) for y, z in zip(ys.ravel(), zs.ravel())]
+    return [
+        Emitter((0.0, float(y), float(z)), (1.0, 0.0, 0.0)) for y, z in zip(ys.ravel(), zs.ravel())
+    ]
 
 
 def _sensor_at(b, x: float, emitters, cfg=None):
@@ -76,7 +79,9 @@ def test_range_limits(backend, gap, expect):
         assert r.valid.all() and (r.body == wall).all()
         assert np.allclose(r.distance, gap, atol=6 * ToFConfig().std_at(gap))
     else:  # beyond 100 mm: nothing
-        assert np.isinf(r.distance).all() and (r.body == -1).all() and np.isinf(r.true_distance).all()
+        assert (
+            np.isinf(r.distance).all() and (r.body == -1).all() and np.isinf(r.true_distance).all()
+        )
 
 
 def test_own_body_is_ignored_and_other_bodies_are_reported(backend):
@@ -85,7 +90,9 @@ def test_own_body_is_ignored_and_other_bodies_are_reported(backend):
     body, sensor = _sensor_at(backend, WALL_X - 0.04, [Emitter((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))])
     r = sensor.read(np.random.default_rng(0))
     assert r.body[0] == wall and r.true_distance[0] == pytest.approx(0.04, abs=1e-3)
-    blocker = backend.add_body([Box((0.002, 0.01, 0.01))], Pose([WALL_X - 0.02, -0.02, 0.28]), 0.01, fixed=True)
+    blocker = backend.add_body(
+        [Box((0.002, 0.01, 0.01))], Pose([WALL_X - 0.02, -0.02, 0.28]), 0.01, fixed=True
+    )
     r = sensor.read(np.random.default_rng(0))
     assert r.body[0] == blocker and r.true_distance[0] == pytest.approx(0.018, abs=1e-3)
 
@@ -98,14 +105,22 @@ def test_a_sensor_on_one_link_sees_the_rest_of_its_robot(backend):
     grip = backend.load_urdf(urdf, Pose(), fixed_base=True, name="gripper")
     q = 0.04  # each pad's inner face at q - 9 mm from the centre plane (the rig's URDF)
     backend.set_joint_positions(grip, [0.2, q, q], joints=["lift", "left_finger", "right_finger"])
-    backend.step(1)  # PhysX's scene queries see a joint teleport only after a step (docs/backends.md)
+    backend.step(
+        1
+    )  # PhysX's scene queries see a joint teleport only after a step (docs/backends.md)
     across = [Emitter((0.0, 0.0, 0.0), (0.0, -1.0, 0.0))]  # from pad_l's centre towards pad_r
     whole = PreTouchSensor(backend, grip, "pad_l", across)
-    assert not np.isfinite(whole.read(np.random.default_rng(0)).true_distance[0])  # the robot is transparent
-    own = PreTouchSensor(backend, grip, "pad_l", across, ignore_bodies=(), ignore_links=((grip, "pad_l"),))
+    assert not np.isfinite(
+        whole.read(np.random.default_rng(0)).true_distance[0]
+    )  # the robot is transparent
+    own = PreTouchSensor(
+        backend, grip, "pad_l", across, ignore_bodies=(), ignore_links=((grip, "pad_l"),)
+    )
     r = own.read(np.random.default_rng(0))
     assert r.body[0] == grip
-    assert r.true_distance[0] == pytest.approx(0.002 + 2 * (q - 0.009), abs=1e-3)  # half pad + the gap
+    assert r.true_distance[0] == pytest.approx(
+        0.002 + 2 * (q - 0.009), abs=1e-3
+    )  # half pad + the gap
 
 
 def test_emitters_follow_the_link_pose_and_belief(backend):
@@ -117,17 +132,24 @@ def test_emitters_follow_the_link_pose_and_belief(backend):
     r = sensor.read(np.random.default_rng(0))
     origin = p + Rotation.from_euler("z", 30, degrees=True).apply([0.01, 0, 0])
     assert np.allclose(r.origins[0], origin, atol=1e-6)
-    assert r.true_distance[0] == pytest.approx((WALL_X - origin[0]) / np.cos(np.deg2rad(30)), abs=1.2e-3)
+    assert r.true_distance[0] == pytest.approx(
+        (WALL_X - origin[0]) / np.cos(np.deg2rad(30)), abs=1.2e-3
+    )
     # a believed pose changes the reported rays, never the ranges
     belief = Pose(p + [0.0, 0.005, 0.0])
     r2 = sensor.read(np.random.default_rng(0), believed_link_pose=belief)
     assert np.array_equal(r2.distance, r.distance)
-    assert np.allclose(r2.origins[0], belief.apply([0.01, 0, 0])) and np.allclose(r2.directions[0], [1, 0, 0])
+    assert np.allclose(r2.origins[0], belief.apply([0.01, 0, 0])) and np.allclose(
+        r2.directions[0], [1, 0, 0]
+    )
 
 
 def test_scan_collects_one_reading_per_step(backend):
     _wall(backend)
-    emitters = [Emitter((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), Emitter((0.0, 0.0, 0.01), (1.0, 0.0, 0.0))]
+    emitters = [
+        Emitter((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+        Emitter((0.0, 0.0, 0.01), (1.0, 0.0, 0.0)),
+    ]
     body, sensor = _sensor_at(backend, WALL_X - 0.05, emitters)
     xs = WALL_X - np.array([0.004, 0.03, 0.06, 0.09, 0.15])
     path = [Pose([x, 0.0, 0.3]) for x in xs]
@@ -140,8 +162,13 @@ def test_scan_collects_one_reading_per_step(backend):
     assert np.isinf(s.distance[8:]).all()  # 150 mm: out of range
     # a belief that offsets the link by 1 cm shows in the reported origins only
     shift = Pose([0.0, 0.01, 0.0])
-    s2 = scan(sensor, path, free_body_mover(backend, body), np.random.default_rng(1),
-              belief=lambda cmd, actual: shift * actual)
+    s2 = scan(
+        sensor,
+        path,
+        free_body_mover(backend, body),
+        np.random.default_rng(1),
+        belief=lambda cmd, actual: shift * actual,
+    )
     assert np.allclose(s2.origins - s.origins, [0.0, 0.01, 0.0])
     assert np.array_equal(s2.distance, s.distance, equal_nan=True)
 

@@ -14,12 +14,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from sensor_rig import BACKENDS, new_backend
 
 from benchharness.backends import Box
 from benchharness.geometry import Pose
 from benchharness.sensors import ray_box
-
-from sensor_rig import BACKENDS, new_backend
 
 pytestmark = pytest.mark.sim
 
@@ -66,7 +65,9 @@ def test_model_matches_engine_ray_cast(backend_name):
             cos_inc = -np.einsum("ij,ij->i", mod.normal, d)
             worst = max(worst, float(err.max()))
             # the engine's surface lies within 1 mm of the model's along the normal ...
-            assert (err * cos_inc).max() <= 1e-3, f"{backend_name}: surface off by {(err * cos_inc).max() * 1e3:.2f} mm"
+            assert (err * cos_inc).max() <= 1e-3, (
+                f"{backend_name}: surface off by {(err * cos_inc).max() * 1e3:.2f} mm"
+            )
             # ... so ranges agree within 1 mm (1/cos 20° = 1.064 at worst)
             assert np.percentile(err, 99) <= 1e-3 and err.max() <= 1.064e-3
             if backend_name == "sapien":  # PhysX intersects the exact box (in float32)
@@ -98,7 +99,9 @@ def test_model_and_engine_agree_on_misses(backend_name):
         mod = ray_box(o, d, centre, rot.as_matrix(), HALF)
         assert not mod.hit.any() and not eng.hit.any()
         # and the same rays moved 6 mm inwards hit both, at the -x face
-        o_in = centre + rot.apply(o_b - np.column_stack([np.zeros(n), np.sign(y) * 0.006, np.zeros(n)]))
+        o_in = centre + rot.apply(
+            o_b - np.column_stack([np.zeros(n), np.sign(y) * 0.006, np.zeros(n)])
+        )
         eng = b.ray_cast(o_in, d, 0.3)
         mod = ray_box(o_in, d, centre, rot.as_matrix(), HALF)
         assert mod.hit.all() and eng.hit.all()

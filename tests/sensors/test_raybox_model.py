@@ -12,7 +12,14 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from benchharness.sensors import cube_tilt, cube_yaw, ray_box, ray_box_jacobian, wrap_quarter, yaw_error
+from benchharness.sensors import (
+    cube_tilt,
+    cube_yaw,
+    ray_box,
+    ray_box_jacobian,
+    wrap_quarter,
+    yaw_error,
+)
 
 H = 0.0285
 
@@ -32,12 +39,14 @@ def test_axis_aligned_hits_by_hand():
 
 def test_misses_inside_and_parallel():
     c = np.zeros(3)
-    o = np.array([
-        [-0.1, 0.05, 0.0],  # passes beside the box
-        [0.0, 0.0, 0.0],  # starts inside: a ToF window is never inside the cube
-        [-0.1, H + 1e-4, 0.0],  # parallel to the +y face, just outside it
-        [0.1, 0.0, 0.0],  # points away
-    ])
+    o = np.array(
+        [
+            [-0.1, 0.05, 0.0],  # passes beside the box
+            [0.0, 0.0, 0.0],  # starts inside: a ToF window is never inside the cube
+            [-0.1, H + 1e-4, 0.0],  # parallel to the +y face, just outside it
+            [0.1, 0.0, 0.0],  # points away
+        ]
+    )
     d = np.array([[1.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0]])
     r = ray_box(o, d, c, np.eye(3), H)
     assert not r.hit.any()
@@ -62,7 +71,7 @@ def test_jacobian_matches_finite_differences():
         d /= np.linalg.norm(d)
         o = target - 0.08 * d
 
-        def rng_at(s):
+        def rng_at(s, o=o, d=d):
             return ray_box(o, d, s[:3], Rotation.from_euler("z", s[3]).as_matrix(), H)
 
         hit = rng_at(x)
@@ -83,7 +92,9 @@ def test_wrap_quarter():
     deg = np.array([-45.0, 45.0, 46.0, -46.0, 90.0, 135.0, 44.9, -180.0])
     want = np.array([45.0, 45.0, -44.0, 44.0, 0.0, 45.0, 44.9, 0.0])
     assert np.allclose(np.rad2deg(wrap_quarter(np.deg2rad(deg))), want)
-    assert math.degrees(yaw_error(math.radians(44), math.radians(-46))) == pytest.approx(0.0, abs=1e-9)
+    assert math.degrees(yaw_error(math.radians(44), math.radians(-46))) == pytest.approx(
+        0.0, abs=1e-9
+    )
 
 
 def _cube_symmetries() -> list[Rotation]:

@@ -48,18 +48,26 @@ def test_cube_kf_factory():
 @pytest.mark.sim
 @pytest.mark.parametrize("backend_name", ["pybullet", "sapien"])
 def test_pretouch_factory(backend_name):
+    from sensor_rig import new_backend
+
     from benchharness.backends import Sphere
     from benchharness.sensors import Emitter
-
-    from sensor_rig import new_backend
 
     b = new_backend(backend_name)
     try:
         body = b.add_body([Sphere(0.004)], Pose([0, 0, 0.5]), 0.01)
-        s = get_manager().create("sensor", "pretouch-tof", backend=b, body=body,
-                                 emitters=[Emitter((0, 0, 0), (0, 0, -1))], max_range=0.6)
+        s = get_manager().create(
+            "sensor",
+            "pretouch-tof",
+            backend=b,
+            body=body,
+            emitters=[Emitter((0, 0, 0), (0, 0, -1))],
+            max_range=0.6,
+        )
         r = s.read(np.random.default_rng(0))
-        assert s.config.max_range == 0.6 and np.isinf(r.distance[0])  # nothing below but empty space
+        assert s.config.max_range == 0.6 and np.isinf(
+            r.distance[0]
+        )  # nothing below but empty space
         b.add_ground(0.0)
         assert s.read(np.random.default_rng(0)).distance[0] == pytest.approx(0.5, abs=0.01)
     finally:
@@ -76,5 +84,7 @@ def test_importing_sensors_pulls_in_no_engine_and_no_filterpy():
         "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'pybullet', 'sapien', 'torch', 'filterpy'})\n"
         "print(','.join(heavy))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.strip()
     assert out == ""

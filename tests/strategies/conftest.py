@@ -25,8 +25,17 @@ def make_ctx():
         seq = tuple(parse_sequence(sequence))
         item = RubiksItem("Rubiks-1-1", 1, 1, seq, seed)
         rec = TrialRecorder(clock=lambda: float(b.time))
-        ctx = TrialContext(item=item, trial_index=1, robot=m.create("robot", "pr2"), backend=b, sensors={},
-                           rng=np.random.default_rng(seed), budget=TimeBudget(), recorder=rec, physics=phys)
+        ctx = TrialContext(
+            item=item,
+            trial_index=1,
+            robot=m.create("robot", "pr2"),
+            backend=b,
+            sensors={},
+            rng=np.random.default_rng(seed),
+            budget=TimeBudget(),
+            recorder=rec,
+            physics=phys,
+        )
         return ctx, b
 
     yield make

@@ -18,8 +18,17 @@ def make_context(backend: str, item: InhandItem, seed: int = 0):
     phys = PhysicsConfig(seed=seed)
     b = m.create("backend", backend, config=phys)
     rec = TrialRecorder(clock=lambda: float(b.time))
-    ctx = TrialContext(item=item, trial_index=1, robot=m.create("robot", "pr2-gripper"), backend=b, sensors={},
-                       rng=np.random.default_rng(seed), budget=TimeBudget(), recorder=rec, physics=phys)
+    ctx = TrialContext(
+        item=item,
+        trial_index=1,
+        robot=m.create("robot", "pr2-gripper"),
+        backend=b,
+        sensors={},
+        rng=np.random.default_rng(seed),
+        budget=TimeBudget(),
+        recorder=rec,
+        physics=phys,
+    )
     return ctx, b
 
 

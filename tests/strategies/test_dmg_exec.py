@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from gripper_helpers import BACKENDS, make_context, task_item
 from scipy.spatial.transform import Rotation
 
 from benchharness.runner.contract import InhandItem
@@ -19,18 +20,25 @@ from benchharness.runner.scoring import score_inhand
 from benchharness.strategies.dmg.execution import DMGExecConfig
 from benchharness.strategies.pivoting.config import ExecutionConfig, HoldConfig
 
-from gripper_helpers import BACKENDS, make_context, task_item
-
 SHORT = DMGExecConfig(execution=ExecutionConfig(hold=HoldConfig(hold_time=1.0)))
 
 
 def _short_item() -> InhandItem:
     """The published gelatin-box initial grasp; desired: the same contacts, gripper turned -30 deg about its z."""
     pub = task_item("inhand-level3-dmg", 0)
-    q = (Rotation.from_quat(pub.initial[3:]) * Rotation.from_rotvec([0.0, 0.0, math.radians(-30.0)])).as_quat()
+    q = (
+        Rotation.from_quat(pub.initial[3:]) * Rotation.from_rotvec([0.0, 0.0, math.radians(-30.0)])
+    ).as_quat()
     desired = np.concatenate([pub.initial[:3], q])
-    return InhandItem("test-dmg-short", "gelatin-rot30", "gelatin box", 3, pub.initial.copy(), desired,
-                      contacts={"initial": pub.contacts["initial"], "desired": pub.contacts["initial"]})
+    return InhandItem(
+        "test-dmg-short",
+        "gelatin-rot30",
+        "gelatin box",
+        3,
+        pub.initial.copy(),
+        desired,
+        contacts={"initial": pub.contacts["initial"], "desired": pub.contacts["initial"]},
+    )
 
 
 def _planner(execution=SHORT):
@@ -55,7 +63,9 @@ def test_short_dmg_task_executes_and_scores(backend):
     assert v.status.value == "success", v.message
     m = v.outcome["metrics"]
     assert m["err_or_percent"] < 1.0, m  # < ~1.6 deg off the desired orientation
-    assert m["err_pos"] < 0.006, m  # set-up noise (2 mm per axis) and the snapping to a patch centre
+    assert m["err_pos"] < 0.006, (
+        m
+    )  # set-up noise (2 mm per axis) and the snapping to a patch centre
     assert out.plan_time_s > 0 and out.exec_time_s > 0
     g = contact_errors(item.object, item.contacts["desired"], out.reached_contacts)
     assert 0.0 <= g["g_euc"] < 0.015 and g["g_min"] > 0
@@ -75,7 +85,10 @@ def test_plan_to_region_ends_in_the_region():
     assert p.reached_goal
     z = des[1] - des[0]
     on, _ = surface_contacts(dmg.mesh, des, z / np.linalg.norm(z))
-    assert np.linalg.norm(p.final.contacts[p.start.principal] - on[p.start.principal]) < dmg.config.patch_size
+    assert (
+        np.linalg.norm(p.final.contacts[p.start.principal] - on[p.start.principal])
+        < dmg.config.patch_size
+    )
     assert not np.all(np.isfinite(item.desired))  # Level II: no desired hand pose
 
 
@@ -97,9 +110,17 @@ def test_dmg_execution_refuses_other_robots():
     m = get_manager()
     b = m.create("backend", "pybullet", config=PhysicsConfig())
     try:
-        ctx = TrialContext(item=item, trial_index=1, robot=m.create("robot", "pr2"), backend=b, sensors={},
-                           rng=np.random.default_rng(0), budget=TimeBudget(), recorder=TrialRecorder(),
-                           physics=PhysicsConfig())
+        ctx = TrialContext(
+            item=item,
+            trial_index=1,
+            robot=m.create("robot", "pr2"),
+            backend=b,
+            sensors={},
+            rng=np.random.default_rng(0),
+            budget=TimeBudget(),
+            recorder=TrialRecorder(),
+            physics=PhysicsConfig(),
+        )
         with pytest.raises(ValueError, match="pr2-gripper"):
             _planner().run_trial(ctx)
     finally:

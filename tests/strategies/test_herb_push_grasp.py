@@ -38,8 +38,11 @@ def test_registered_for_herb_and_refuses_other_robots(make_ctx):
 
 
 def test_push_grip_frames_against_hand_computed_ones():
-    from benchharness.strategies.herb_rubiks.frames import (HERB_FROM_PR2, push_grip_candidates,
-                                                            reanchor_along_approach)
+    from benchharness.strategies.herb_rubiks.frames import (
+        HERB_FROM_PR2,
+        push_grip_candidates,
+        reanchor_along_approach,
+    )
 
     assert np.isclose(np.linalg.det(HERB_FROM_PR2.as_matrix()), 1.0)
     cube = Pose.from_rotation([0.6, 0.0, 1.0], Rotation.from_euler("z", -90, degrees=True))
@@ -61,7 +64,11 @@ def test_push_grip_frames_against_hand_computed_ones():
 def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_robot, backend):
     """Push-grasp a cube on a pedestal from above with the belief 8 mm off, both ways; check with the true pose."""
     from benchharness.strategies.herb_rubiks.frames import reanchor_along_approach, thumb_face_depth
-    from benchharness.strategies.herb_rubiks.push import close_outer_fingers, preshape, push_until_contact
+    from benchharness.strategies.herb_rubiks.push import (
+        close_outer_fingers,
+        preshape,
+        push_until_contact,
+    )
 
     be = make_backend(backend)
     be.add_ground()
@@ -70,35 +77,57 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
     arm, hand = robot.arm("left_arm"), robot.hand("left_hand")
     home = arm.tcp_pose()  # pointing straight down
     top = home.p[2] - 0.09
-    be.add_body([Box((0.02, 0.02, (top - 2 * CUBE_HALF) / 2))], Pose([home.p[0], home.p[1], (top - 2 * CUBE_HALF) / 2]),
-                1.0, fixed=True, name="pedestal")
-    cube = be.add_body([Box((CUBE_HALF,) * 3)], Pose([home.p[0], home.p[1], top - CUBE_HALF + 5e-4]), 0.094,
-                       friction=1.0, name="cube")
+    be.add_body(
+        [Box((0.02, 0.02, (top - 2 * CUBE_HALF) / 2))],
+        Pose([home.p[0], home.p[1], (top - 2 * CUBE_HALF) / 2]),
+        1.0,
+        fixed=True,
+        name="pedestal",
+    )
+    cube = be.add_body(
+        [Box((CUBE_HALF,) * 3)],
+        Pose([home.p[0], home.p[1], top - CUBE_HALF + 5e-4]),
+        0.094,
+        friction=1.0,
+        name="cube",
+    )
     preshape(hand, np.pi / 2, 0.55)
     robot.settle(0.2)
     design = thumb_face_depth(arm.tcp_pose(), be.get_link_pose(robot.body, "l_bh_finger_33_link"))
     assert 0.025 < design < 0.04
     for sign in (1.0, -1.0):
         true = be.get_pose(cube)
-        belief = Pose(true.p + [0.0, 0.0, -sign * BELIEF_ERROR], true.q)  # approach is -z: sign>0 = believed farther
+        belief = Pose(
+            true.p + [0.0, 0.0, -sign * BELIEF_ERROR], true.q
+        )  # approach is -z: sign>0 = believed farther
         # the grasp the belief asks for, 3 cm before the believed contact
         grip = Pose([true.p[0], true.p[1], belief.p[2] + CUBE_HALF + design], home.q)
         start = Pose(grip.p + [0.0, 0.0, 0.03], grip.q)
         assert arm.move_to_pose(start, settle=0.2).ik_success
-        res = push_until_contact(robot, arm, hand, cube, start, limit=0.06, speed=0.03, force_threshold=1.0)
+        res = push_until_contact(
+            robot, arm, hand, cube, start, limit=0.06, speed=0.03, force_threshold=1.0
+        )
         assert res.contact and any(link.endswith("finger_33_link") for link in res.links)
         # independent check: true face depth in the hand's true tool frame vs the designed depth
         tcp, true = arm.tcp_pose(), be.get_pose(cube)
-        face_in_tool = float(np.dot(true.p + [0, 0, CUBE_HALF] - tcp.p, tcp.rotation.apply([0, 0, 1])))
+        face_in_tool = float(
+            np.dot(true.p + [0, 0, CUBE_HALF] - tcp.p, tcp.rotation.apply([0, 0, 1]))
+        )
         grasp_error = abs(face_in_tool - design)
-        believed_error = abs(float(grip.p[2] - tcp.p[2]) - 0.0)  # where dead reckoning would have put the hand
+        believed_error = abs(
+            float(grip.p[2] - tcp.p[2]) - 0.0
+        )  # where dead reckoning would have put the hand
         assert grasp_error < 0.003, (backend, sign, grasp_error)
         assert grasp_error < BELIEF_ERROR / 2
-        assert believed_error > BELIEF_ERROR - 0.003  # the hand did stop ~8 mm away from the believed grasp
+        assert (
+            believed_error > BELIEF_ERROR - 0.003
+        )  # the hand did stop ~8 mm away from the believed grasp
         fixed, shift = reanchor_along_approach(belief, res.commanded, design)
         assert abs(fixed.p[2] - true.p[2]) < 0.003
         assert abs(shift) == pytest.approx(BELIEF_ERROR, abs=0.003)
-        assert np.linalg.norm(true.p[:2] - [home.p[0], home.p[1]]) < 0.002  # the push did not shove the cube
+        assert (
+            np.linalg.norm(true.p[:2] - [home.p[0], home.p[1]]) < 0.002
+        )  # the push did not shove the cube
         close_outer_fingers(hand, 2.0)
         assert hand.touching(cube)
         u = hand.command.copy()
@@ -109,20 +138,33 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
 
 def test_hand_over_clearance_geometry():
     """The taker's closing fingers against the other hand's finger boxes (no physics, hand-computed cases)."""
-    from benchharness.strategies.herb_rubiks.frames import DIST_CORNERS, band_clear, finger_extent, thumb_tip_lateral
+    from benchharness.strategies.herb_rubiks.frames import (
+        DIST_CORNERS,
+        band_clear,
+        finger_extent,
+        thumb_tip_lateral,
+    )
 
     # an obstacle box across the palm (tool y) from 0 to 20 mm, 30-60 mm beyond the tool frame
     lo, hi = np.array([-0.05, 0.0, 0.03]), np.array([0.05, 0.02, 0.06])
-    assert not band_clear(lo, hi, 0.0, 0.012, 0.049, 0.003)  # fingers at 0 +- 12 mm reach 49 mm: they meet it
-    assert band_clear(lo, hi, -0.016, 0.012, 0.049, 0.003)  # slid 16 mm the other way: 16 - 12 >= 3 mm
+    assert not band_clear(
+        lo, hi, 0.0, 0.012, 0.049, 0.003
+    )  # fingers at 0 +- 12 mm reach 49 mm: they meet it
+    assert band_clear(
+        lo, hi, -0.016, 0.012, 0.049, 0.003
+    )  # slid 16 mm the other way: 16 - 12 >= 3 mm
     assert not band_clear(lo, hi, -0.014, 0.012, 0.049, 0.003)  # 14 mm: 2 mm < the 3 mm clearance
     assert band_clear(lo, hi, 0.035, 0.012, 0.049, 0.003)  # past its far side
     assert band_clear(lo, hi, 0.0, 0.012, 0.025, 0.003)  # a shorter reach stops short of it
     # finger_extent: a link box placed relative to the *believed* tool pose, seen from another frame
     tool_meas = Pose([1.0, 2.0, 3.0])
     link = Pose([1.0, 2.0, 3.05])  # 50 mm beyond the measured tool frame along z, unrotated
-    lo2, hi2 = finger_extent(Pose([0.0, 0.0, 0.0]), tool_meas, [(link, DIST_CORNERS)], Pose([0.0, 0.0, 0.0]))
-    assert np.allclose(lo2, [-0.011, -0.007, 0.053], atol=1e-9) and np.allclose(hi2, [0.011, 0.007, 0.102], atol=1e-9)
+    lo2, hi2 = finger_extent(
+        Pose([0.0, 0.0, 0.0]), tool_meas, [(link, DIST_CORNERS)], Pose([0.0, 0.0, 0.0])
+    )
+    assert np.allclose(lo2, [-0.011, -0.007, 0.053], atol=1e-9) and np.allclose(
+        hi2, [0.011, 0.007, 0.102], atol=1e-9
+    )
     # thumb tip: a distal link curled 60 deg from the approach towards tool -y touches with its far end's
     # corners on the approach side (link y = +7 mm): tool y = -52 mm sin 60 + 7 mm cos 60
     distal = Pose.from_rotation([0.0, 0.0, 0.03], Rotation.from_euler("x", 60, degrees=True))
@@ -143,8 +185,17 @@ def _herb_ctx(backend: str, sequence: str, seed: int = 0):
     b = m.create("backend", backend, config=phys)
     item = RubiksItem("Rubiks-1-1", 1, 1, tuple(parse_sequence(sequence)), seed)
     rec = TrialRecorder(clock=lambda: float(b.time))
-    ctx = TrialContext(item=item, trial_index=1, robot=m.create("robot", "herb"), backend=b, sensors={},
-                       rng=np.random.default_rng(seed), budget=TimeBudget(), recorder=rec, physics=phys)
+    ctx = TrialContext(
+        item=item,
+        trial_index=1,
+        robot=m.create("robot", "herb"),
+        backend=b,
+        sensors={},
+        rng=np.random.default_rng(seed),
+        budget=TimeBudget(),
+        recorder=rec,
+        physics=phys,
+    )
     return ctx, b
 
 
@@ -162,13 +213,17 @@ def test_whole_one_move_trial_with_injected_errors(backend):
     try:
         out = PushGraspStrategy().run_trial(ctx)
         assert out.failure is None, out.message
-        assert out.final_state == to_string(apply(SOLVED, "R"))  # the cube core, independent of the strategy
+        assert out.final_state == to_string(
+            apply(SOLVED, "R")
+        )  # the cube core, independent of the strategy
         moves = [e for e in ctx.recorder.to_json()["events"] if e["kind"] == "move"]
         assert len(moves) == 1 and moves[0]["as_intended"]
         pushes = [e for e in ctx.recorder.to_json()["events"] if e["kind"] == "push"]
         # every push put its grasp on its slab: the true error along the push (read after the stop; it
         # includes the held cube yielding under the push, 5.2 mm measured on PyBullet) under half a slab
-        assert len(pushes) == 2 and all(abs(p["true_error_along_approach_mm"]) < 9.5 for p in pushes)
+        assert len(pushes) == 2 and all(
+            abs(p["true_error_along_approach_mm"]) < 9.5 for p in pushes
+        )
     finally:
         b.close()
 
@@ -185,18 +240,46 @@ def test_rubiks_1_5_through_the_cli_is_scored(tmp_path, backend):
     import json
 
     store = tmp_path / "herb.sqlite"
-    cmd = [sys.executable, "-m", "benchharness.cli.main", "run", "--task", "Rubiks-1-5", "--robot", "herb",
-           "--strategy", "push-grasp", "--backend", backend, "--seed", "0", "--workers", "0",
-           "--store", str(store), "--json", "--no-progress"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "benchharness.cli.main",
+        "run",
+        "--task",
+        "Rubiks-1-5",
+        "--robot",
+        "herb",
+        "--strategy",
+        "push-grasp",
+        "--backend",
+        backend,
+        "--seed",
+        "0",
+        "--workers",
+        "0",
+        "--store",
+        str(store),
+        "--json",
+        "--no-progress",
+    ]
     out = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
     assert out.returncode in (0, 1), out.stderr[-2000:]
-    assert "strategy_error" not in out.stdout and "simulator_error" not in out.stdout, out.stdout[-3000:]
-    res = subprocess.run([sys.executable, "-m", "benchharness.cli.main", "results", "--store", str(store), "--json"],
-                         capture_output=True, text=True, timeout=120)
+    assert "strategy_error" not in out.stdout and "simulator_error" not in out.stdout, out.stdout[
+        -3000:
+    ]
+    res = subprocess.run(
+        [sys.executable, "-m", "benchharness.cli.main", "results", "--store", str(store), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr[-2000:]
     trials = json.loads(res.stdout)["trials"]
     assert len(trials) == 1
     if backend == "sapien":
         trial = trials[0]
         assert trial["status"] == "success", trial
-        assert trial["diagnostics_counts"]["move"] == 5 and trial["diagnostics_counts"]["unintended_rotation"] == 0
+        assert (
+            trial["diagnostics_counts"]["move"] == 5
+            and trial["diagnostics_counts"]["unintended_rotation"] == 0
+        )

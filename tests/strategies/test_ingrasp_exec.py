@@ -25,7 +25,9 @@ from benchharness.strategies.ingrasp.stiff_plugin import STIFF
 from benchharness.strategies.ingrasp.strategy import InGraspPlanner, _shared_hand
 from benchharness.strategies.ingrasp.tasks import published_tasks
 
-TASK = "orange-01"  # a sphere: the placement solve is one candidate (fast) and the grasp is well posed
+TASK = (
+    "orange-01"  # a sphere: the placement solve is one candidate (fast) and the grasp is well posed
+)
 #: Bound on |executed - planned| reached position. Measured 0.54 cm (PyBullet), 0.22 cm (SAPIEN) for this
 #: task; the planned motion is 4.6 cm, so the bound still says the object went where the plan said.
 EXEC_VS_PLAN_CM = 1.0
@@ -39,7 +41,9 @@ def task():
 
 @pytest.fixture(scope="module")
 def planner():
-    return InGraspPlanner("relaxed-rigidity", config=IngraspConfig(**STIFF), exec_config=ExecConfig(hold_s=1.0))
+    return InGraspPlanner(
+        "relaxed-rigidity", config=IngraspConfig(**STIFF), exec_config=ExecConfig(hold_s=1.0)
+    )
 
 
 @pytest.fixture(scope="module")
@@ -47,16 +51,31 @@ def plan(planner, task):
     return planner.plan_task(task)
 
 
-def _run(planner, task, plan, backend: str, seed: int = 0, physics: PhysicsConfig | None = None,
-         config: ExecConfig | None = None, step_hook=None):
+def _run(
+    planner,
+    task,
+    plan,
+    backend: str,
+    seed: int = 0,
+    physics: PhysicsConfig | None = None,
+    config: ExecConfig | None = None,
+    step_hook=None,
+):
     m = get_manager()
     be = m.create("backend", backend, config=physics or PhysicsConfig())
     try:
         if step_hook is not None:
             step_hook(be)
         ex = InGraspExecutor(planner.hand, config or planner.exec_config)
-        return ex.run(be, m.create("robot", "allegro"), planner.problem(task), plan, task.object,
-                      np.random.default_rng(seed), duration_s=planner.config.duration_s)
+        return ex.run(
+            be,
+            m.create("robot", "allegro"),
+            planner.problem(task),
+            plan,
+            task.object,
+            np.random.default_rng(seed),
+            duration_s=planner.config.duration_s,
+        )
     finally:
         be.close()
 
@@ -83,8 +102,14 @@ def test_zero_friction_palm_down_drops(planner, task, plan, backend):
     (Palm up, a sphere resting on three fingertips needs no friction at all, so zero friction
     alone is not a drop there; that is physics, not a detection failure.)
     """
-    out = _run(planner, task, plan, backend, physics=PhysicsConfig(default_friction=0.0),
-               config=ExecConfig(palm="down", hold_s=1.0))
+    out = _run(
+        planner,
+        task,
+        plan,
+        backend,
+        physics=PhysicsConfig(default_friction=0.0),
+        config=ExecConfig(palm="down", hold_s=1.0),
+    )
     assert out.dropped
     assert out.phase in ("setup", "execution", "hold")
     assert "dropped" in out.message
@@ -98,7 +123,9 @@ def test_same_seed_same_result(planner, task, plan):
     np.testing.assert_array_equal(a.reached, b.reached)
     np.testing.assert_array_equal(a.setup, b.setup)
     assert a.extra["setup_noise_pos_mm"] == b.extra["setup_noise_pos_mm"]
-    assert a.extra["setup_noise_pos_mm"] != c.extra["setup_noise_pos_mm"]  # the noise comes from the rng
+    assert (
+        a.extra["setup_noise_pos_mm"] != c.extra["setup_noise_pos_mm"]
+    )  # the noise comes from the rng
 
 
 def test_blow_up_is_reported_not_raised(task):
@@ -119,10 +146,20 @@ def test_blow_up_is_reported_not_raised(task):
 
     be.step = step
     item = InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired)
-    ctx = TrialContext(item=item, trial_index=1, robot=m.create("robot", "allegro"), backend=be, sensors={},
-                       rng=np.random.default_rng(0), budget=TimeBudget(), recorder=TrialRecorder(lambda: be.time),
-                       physics=be.config)
-    planner = InGraspPlanner("relaxed-rigidity", max_iterations=5)  # plan quality is irrelevant here
+    ctx = TrialContext(
+        item=item,
+        trial_index=1,
+        robot=m.create("robot", "allegro"),
+        backend=be,
+        sensors={},
+        rng=np.random.default_rng(0),
+        budget=TimeBudget(),
+        recorder=TrialRecorder(lambda: be.time),
+        physics=be.config,
+    )
+    planner = InGraspPlanner(
+        "relaxed-rigidity", max_iterations=5
+    )  # plan quality is irrelevant here
     try:
         out = planner.run_trial(ctx)
     finally:
@@ -136,16 +173,20 @@ def test_squeeze_is_internal():
     """The squeeze forces f_i = s (g - p_i) sum to zero and have zero moment about the origin."""
     hand = _shared_hand()
     t = {x.task_id: x for x in published_tasks()}[TASK]
-    from benchharness.strategies.ingrasp.problem import problem_from_task
     from benchharness.strategies.ingrasp.execution import _jacobians
+    from benchharness.strategies.ingrasp.problem import problem_from_task
 
     p = problem_from_task(t, hand)
     k = np.full(12, 3.0)
     dq = squeeze_offsets(hand, p.q0, p.fingers, 2.0, k)
     pos, jac = _jacobians(hand, p.q0, p.fingers)
     # recover each fingertip's force from its joint torques: tau = J^T f (J is 3x4, full row rank)
-    f = np.array([np.linalg.lstsq(jac[i].T, k[4 * i: 4 * i + 4] * dq[4 * i: 4 * i + 4], rcond=None)[0]
-                  for i in range(3)])
+    f = np.array(
+        [
+            np.linalg.lstsq(jac[i].T, k[4 * i : 4 * i + 4] * dq[4 * i : 4 * i + 4], rcond=None)[0]
+            for i in range(3)
+        ]
+    )
     np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-9)
     np.testing.assert_allclose(np.cross(pos, f).sum(axis=0), 0.0, atol=1e-9)
     assert np.mean(np.linalg.norm(f, axis=1)) == pytest.approx(2.0)
@@ -185,8 +226,13 @@ def test_through_the_runner(backend, tmp_path):
     from benchharness.runner.spec import RunSpec
     from benchharness.runner.trial import execute_trial, plan_for
 
-    spec = RunSpec(task="inhand-level1", robot="allegro", strategy="relaxed-rigidity-stiff", backend=backend,
-                   plugins=("benchharness.strategies.ingrasp.stiff_plugin",))
+    spec = RunSpec(
+        task="inhand-level1",
+        robot="allegro",
+        strategy="relaxed-rigidity-stiff",
+        backend=backend,
+        plugins=("benchharness.strategies.ingrasp.stiff_plugin",),
+    )
     index = next(i for i, it in plan_for(spec).items.items() if it.task_id == TASK)
     rec = execute_trial(spec, index)
     assert rec.status.value in ("success", "discarded"), rec.message
@@ -198,7 +244,13 @@ def test_refuses_other_robots(planner, task, plan):
     be = m.create("backend", "pybullet")
     try:
         with pytest.raises(ValueError, match="allegro"):
-            InGraspExecutor(planner.hand).run(be, m.create("robot", "pr2"), planner.problem(task), plan, task.object,
-                                             np.random.default_rng(0))
+            InGraspExecutor(planner.hand).run(
+                be,
+                m.create("robot", "pr2"),
+                planner.problem(task),
+                plan,
+                task.object,
+                np.random.default_rng(0),
+            )
     finally:
         be.close()

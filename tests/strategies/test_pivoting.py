@@ -12,20 +12,30 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from gripper_helpers import BACKENDS, make_context, task_item
 from scipy.spatial.transform import Rotation
 
 from benchharness.geometry import Pose
 from benchharness.runner.scoring import score_inhand
-from benchharness.strategies.pivoting.config import ExecutionConfig, GripConfig, HoldConfig, PivotConfig, SetupConfig
-
-from gripper_helpers import BACKENDS, make_context, task_item
+from benchharness.strategies.pivoting.config import (
+    ExecutionConfig,
+    GripConfig,
+    HoldConfig,
+    PivotConfig,
+    SetupConfig,
+)
 
 #: A pivot must end within this of the commanded angle (deg), measured on the object's engine pose.
 PIVOT_TOLERANCE_DEG = 1.5
 SHORT_HOLD = HoldConfig(hold_time=1.0)
 
 
-def _rig(backend_name: str, seed: int = 0, setup: SetupConfig | None = None, grip: GripConfig | None = None):
+def _rig(
+    backend_name: str,
+    seed: int = 0,
+    setup: SetupConfig | None = None,
+    grip: GripConfig | None = None,
+):
     from benchharness.objects import load_object
     from benchharness.strategies.pivoting.rig import TableRig
     from benchharness.strategies.pivoting.tasks import initial_grasp, rest_pose
@@ -58,7 +68,9 @@ def test_pivot_reaches_commanded_angle(backend):
         obj0 = b.get_pose(rig.body)
         a0 = _tool_in_object_angle(rig)
         commanded = math.radians(25.0)
-        target = setup * Pose.from_rotation(np.zeros(3), Rotation.from_rotvec([0.0, 0.0, commanded]))
+        target = setup * Pose.from_rotation(
+            np.zeros(3), Rotation.from_rotvec([0.0, 0.0, commanded])
+        )
         log = run_pivots(rig, target, PivotConfig(max_pivots=1))  # one open-loop pivot
         a1 = _tool_in_object_angle(rig)
         turned = math.degrees(a1 - a0)
@@ -66,7 +78,9 @@ def test_pivot_reaches_commanded_angle(backend):
         assert abs(abs(turned) - 25.0) < PIVOT_TOLERANCE_DEG, (turned, log)
         obj1 = b.get_pose(rig.body)
         moved = math.degrees((obj1.rotation * obj0.rotation.inv()).magnitude())
-        assert moved < 2.0, f"the table should hold the object while the gripper turns (it turned {moved:.2f} deg)"
+        assert moved < 2.0, (
+            f"the table should hold the object while the gripper turns (it turned {moved:.2f} deg)"
+        )
         hold = rig.lift_and_hold()
         assert not hold.dropped and hold.stable, hold.message
     finally:
@@ -102,7 +116,9 @@ def test_drop_is_detected(backend):
     rig, b, hi = _rig(backend)
     try:
         rig.setup_grasp(hi, 0.028)
-        rig.config = replace(rig.config, grip=GripConfig(hold_force=0.1))  # the lift's firm grip is too weak
+        rig.config = replace(
+            rig.config, grip=GripConfig(hold_force=0.1)
+        )  # the lift's firm grip is too weak
         hold = rig.lift_and_hold()
     finally:
         b.close()
@@ -120,7 +136,9 @@ def test_pivot_is_deterministic(backend):
             setup = rig.setup_grasp(hi, 0.028)
             target = setup * Pose.from_rotation(np.zeros(3), Rotation.from_rotvec([0.0, 0.0, 0.3]))
             run_pivots(rig, target, PivotConfig(max_pivots=1))
-            finals.append(np.concatenate([b.get_pose(rig.body).as_array(), rig.hand_in_object().as_array()]))
+            finals.append(
+                np.concatenate([b.get_pose(rig.body).as_array(), rig.hand_in_object().as_array()])
+            )
         finally:
             b.close()
     np.testing.assert_allclose(finals[0], finals[1], atol=1e-9)
@@ -131,12 +149,18 @@ def test_pivot_task_file_matches_derivation(tmp_path):
     from benchharness.strategies.pivoting.tasks import write_pivot_tasks
 
     fresh = write_pivot_tasks(tmp_path / "p.csv")
-    assert fresh.read_text() == (tasks_dir() / "inhand" / "level1_pivoting.csv").read_text(), \
+    assert fresh.read_text() == (tasks_dir() / "inhand" / "level1_pivoting.csv").read_text(), (
         "stale: run python -m benchharness.strategies.pivoting.tasks"
+    )
 
 
 def test_pivot_angle_and_grasp_geometry():
-    from benchharness.strategies.pivoting.tasks import GRASP_DEPTH, initial_grasp, pivot_angle, rest_pose
+    from benchharness.strategies.pivoting.tasks import (
+        GRASP_DEPTH,
+        initial_grasp,
+        pivot_angle,
+        rest_pose,
+    )
 
     q0 = [0.0, 0.0, 0.0, 1.0]
     q1 = Rotation.from_rotvec([0.0, -0.3, 0.1]).as_quat()
@@ -144,7 +168,9 @@ def test_pivot_angle_and_grasp_geometry():
     rest = rest_pose("gelatin box", (1, 0, 0), 0.4)
     h = rest * initial_grasp("gelatin box", (1, 0, 0), 0.4, rest)
     assert abs(h.rotation.apply([0, 0, 1.0])[2]) < 1e-9  # grasp axis horizontal
-    assert h.p[2] == pytest.approx(0.0365 * 2 + 5e-4 - GRASP_DEPTH, abs=1e-3)  # upright box, 20 mm below its top
+    assert h.p[2] == pytest.approx(
+        0.0365 * 2 + 5e-4 - GRASP_DEPTH, abs=1e-3
+    )  # upright box, 20 mm below its top
 
 
 def test_bad_inputs_are_refused():

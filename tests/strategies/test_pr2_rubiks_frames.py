@@ -41,9 +41,11 @@ def test_left_rotator_grip_against_hand_computed_frame():
     g = grip_pose(cube, "+y", 0.032, "+x")
     np.testing.assert_allclose(g.p, [0.6, 0.032, 0.8], atol=1e-12)
     m = g.rotation.as_matrix()
-    np.testing.assert_allclose(m[:, 0], [0, -1, 0], atol=1e-12)  # tool x: approach, towards the cube
-    np.testing.assert_allclose(m[:, 1], [1, 0, 0], atol=1e-12)   # tool y: the fingers, along world x
-    np.testing.assert_allclose(m[:, 2], [0, 0, 1], atol=1e-12)   # right-handed
+    np.testing.assert_allclose(
+        m[:, 0], [0, -1, 0], atol=1e-12
+    )  # tool x: approach, towards the cube
+    np.testing.assert_allclose(m[:, 1], [1, 0, 0], atol=1e-12)  # tool y: the fingers, along world x
+    np.testing.assert_allclose(m[:, 2], [0, 0, 1], atol=1e-12)  # right-handed
 
 
 def test_grip_follows_a_yawed_and_shifted_estimate():
@@ -53,7 +55,9 @@ def test_grip_follows_a_yawed_and_shifted_estimate():
     g = grip_pose(est, "-y", 0.011, "+z")
     expect_p = np.array([0.603 + 0.011 * math.sin(yaw), -0.002 - 0.011 * math.cos(yaw), 0.8])
     np.testing.assert_allclose(g.p, expect_p, atol=1e-12)
-    np.testing.assert_allclose(g.rotation.as_matrix()[:, 0], [-math.sin(yaw), math.cos(yaw), 0.0], atol=1e-12)
+    np.testing.assert_allclose(
+        g.rotation.as_matrix()[:, 0], [-math.sin(yaw), math.cos(yaw), 0.0], atol=1e-12
+    )
     np.testing.assert_allclose(g.rotation.as_matrix()[:, 1], [0, 0, 1], atol=1e-12)
     # the gripped face is the body's R face (+x body), which the table yaw puts at world -y
     np.testing.assert_allclose(body_axis_along(est, "-y"), [1, 0, 0])
@@ -73,8 +77,12 @@ def test_four_grip_candidates_share_position_and_approach():
 def test_hand_over_turn_and_wrist_roll_frames():
     grip = grip_pose(Pose([0.6, 0.0, 0.8]), "-y", 0.011, "+x")  # right holder, tool x = +y
     turned = rotate_about_point(grip, np.array([0.6, 0.0, 0.8]), "x", -math.pi / 2)
-    np.testing.assert_allclose(turned.p, [0.6, 0.0, 0.811], atol=1e-12)  # -90° about x takes -y to +z
-    np.testing.assert_allclose(turned.rotation.as_matrix()[:, 0], [0, 0, -1], atol=1e-12)  # now pointing down
+    np.testing.assert_allclose(
+        turned.p, [0.6, 0.0, 0.811], atol=1e-12
+    )  # -90° about x takes -y to +z
+    np.testing.assert_allclose(
+        turned.rotation.as_matrix()[:, 0], [0, 0, -1], atol=1e-12
+    )  # now pointing down
     rolled = turned_about_approach(grip, math.pi / 2)
     np.testing.assert_allclose(rolled.p, grip.p)
     np.testing.assert_allclose(rolled.rotation.as_matrix()[:, 0], [0, 1, 0], atol=1e-12)
@@ -87,7 +95,9 @@ def test_wrist_roll_sign_of_a_twist():
     from benchharness.strategies.pr2_rubiks.strategy import DeadReckoningStrategy
     from benchharness.strategies.regrasp import Twist
 
-    assert DeadReckoningStrategy._roll_delta(Twist("left", "y", 2, 1)) == pytest.approx(-math.pi / 2)
+    assert DeadReckoningStrategy._roll_delta(Twist("left", "y", 2, 1)) == pytest.approx(
+        -math.pi / 2
+    )
     assert DeadReckoningStrategy._roll_delta(Twist("right", "y", 0, -2)) == pytest.approx(-math.pi)
 
 
@@ -107,8 +117,12 @@ def test_pad_spans_give_the_intended_slabs():
     half_pad, slab_edge, face = PAD_SIZE[0] / 2, 0.057 / 6, 0.0285
     assert cfg.rotator_offset - half_pad > slab_edge + 0.005  # inner end clear of the middle slab
     assert cfg.holder_offset - half_pad < slab_edge - 0.009  # half a cubie onto the middle slab
-    assert cfg.holder_offset - half_pad > -slab_edge + 0.009  # and half a cubie short of the far slab
-    assert cfg.rotator_offset + half_pad > face and cfg.holder_offset + half_pad >= face - 1e-9  # to the face
+    assert (
+        cfg.holder_offset - half_pad > -slab_edge + 0.009
+    )  # and half a cubie short of the far slab
+    assert (
+        cfg.rotator_offset + half_pad > face and cfg.holder_offset + half_pad >= face - 1e-9
+    )  # to the face
 
 
 def test_side_pick_plans_execute_on_the_logical_cube():
@@ -120,4 +134,6 @@ def test_side_pick_plans_execute_on_the_logical_cube():
         seq = generate_sequence(0, "Rubiks-5-20", trial, 20)
         plan = plan_sequence(seq, model)  # side picks only: the one pick implemented physically
         assert plan.actions[0].approach == "side"
-        assert (execute(plan).state == apply(SOLVED, seq)).all()  # execute raises on any broken rule
+        assert (
+            execute(plan).state == apply(SOLVED, seq)
+        ).all()  # execute raises on any broken rule

@@ -28,7 +28,9 @@ def test_pick_lifts_the_cube_to_the_twisting_pose_held_by_both_hands(make_ctx, b
     assert out.failure is None, out.message
     true = st.cube.pose()
     np.testing.assert_allclose(true.p, cfg.twist_position, atol=0.006)  # lifted and carried
-    assert np.linalg.norm(true.p - st.est.p) < 0.006  # belief (dead reckoning) agrees with the truth
+    assert (
+        np.linalg.norm(true.p - st.est.p) < 0.006
+    )  # belief (dead reckoning) agrees with the truth
     for side in ("left", "right"):
         assert st.hands[side].holding and st.hands[side].gripper.touching(st.cube.body)
     # first contact is found by the runner's step wrapper (not present in-process): the pair must be watched
@@ -38,14 +40,34 @@ def test_pick_lifts_the_cube_to_the_twisting_pose_held_by_both_hands(make_ctx, b
 
 def _run_cli(tmp_path, strategy: str, backend: str, task: str = "Rubiks-1-5"):
     store = tmp_path / "runs.sqlite"
-    cmd = [sys.executable, "-m", "benchharness.cli.main", "run", "--task", task, "--robot", "pr2",
-           "--strategy", strategy, "--backend", backend, "--seed", "0", "--workers", "0", "--store", str(store),
-           "--json"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "benchharness.cli.main",
+        "run",
+        "--task",
+        task,
+        "--robot",
+        "pr2",
+        "--strategy",
+        strategy,
+        "--backend",
+        backend,
+        "--seed",
+        "0",
+        "--workers",
+        "0",
+        "--store",
+        str(store),
+        "--json",
+    ]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
     import sqlite3
 
     con = sqlite3.connect(store)
-    rows = con.execute("select status, failure_cause, message, score, sim_s, diagnostics_json from trials").fetchall()
+    rows = con.execute(
+        "select status, failure_cause, message, score, sim_s, diagnostics_json from trials"
+    ).fetchall()
     return proc, rows
 
 
@@ -66,7 +88,10 @@ def test_short_tier_runs_end_to_end_on_both_backends(tmp_path, backend):
     assert status == "success" or cause in ("wrong_state", "dropped"), (status, cause, message)
     d = json.loads(diag)
     assert d["counts"].get("move", 0) == 5, d["counts"]
-    assert d["counts"].get("unintended_rotation", 0) == 0 and d["counts"].get("blocked_rotation", 0) == 0
+    assert (
+        d["counts"].get("unintended_rotation", 0) == 0
+        and d["counts"].get("blocked_rotation", 0) == 0
+    )
     assert sim_s > 30
 
 

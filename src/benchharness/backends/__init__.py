@@ -52,10 +52,12 @@ __all__ = [
 ]
 
 #: capability flags, known without importing the engines (the classes carry the same values)
-PYBULLET_CAPABILITIES = Capabilities(camera=True, mesh_collision=True, joint_friction=True, mimic_joints=False,
-                                     gravity_torques=True)
-SAPIEN_CAPABILITIES = Capabilities(camera=False, mesh_collision=True, joint_friction=True, mimic_joints=False,
-                                   gravity_torques=True)
+PYBULLET_CAPABILITIES = Capabilities(
+    camera=True, mesh_collision=True, joint_friction=True, mimic_joints=False, gravity_torques=True
+)
+SAPIEN_CAPABILITIES = Capabilities(
+    camera=False, mesh_collision=True, joint_friction=True, mimic_joints=False, gravity_torques=True
+)
 
 
 def create_pybullet(config: PhysicsConfig | None = None) -> Backend:

@@ -8,8 +8,8 @@ backend only applies the result in its own engine.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import numpy as np
 
@@ -89,4 +89,6 @@ def joint_indices(b, joints: Sequence[str] | None) -> list[int]:
         return [b.jmap[n] for n in joints]
     except KeyError as exc:
         names = [j.name for j in b.joints]
-        raise BackendError(f"body {b.name!r} has no movable joint {exc.args[0]!r}; joints: {names}") from None
+        raise BackendError(
+            f"body {b.name!r} has no movable joint {exc.args[0]!r}; joints: {names}"
+        ) from None

@@ -15,9 +15,9 @@ import math
 import os
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -50,7 +50,11 @@ def _shape_volume_com_inertia(shape: Shape) -> tuple[float, np.ndarray, np.ndarr
 
         hull = trimesh.convex.convex_hull(np.asarray(shape.vertices, dtype=float))
         v = float(hull.volume)
-        return v, np.asarray(hull.center_mass, dtype=float), np.asarray(hull.moment_inertia, dtype=float)
+        return (
+            v,
+            np.asarray(hull.center_mass, dtype=float),
+            np.asarray(hull.moment_inertia, dtype=float),
+        )
     raise BackendError(f"unknown shape type {type(shape).__name__}")
 
 
@@ -94,11 +98,15 @@ def mass_properties(
     if com is not None:
         c_body = np.asarray(com, dtype=float)
     if inertia_diag is not None:
-        return MassProperties(float(mass), c_body, np.asarray(inertia_diag, dtype=float), np.array([0, 0, 0, 1.0]))
+        return MassProperties(
+            float(mass), c_body, np.asarray(inertia_diag, dtype=float), np.array([0, 0, 0, 1.0])
+        )
     w, vec = np.linalg.eigh(0.5 * (i_body + i_body.T))
     if np.linalg.det(vec) < 0:
         vec[:, 2] *= -1
-    if np.allclose(i_body, np.diag(np.diag(i_body)), atol=1e-12 * max(1e-30, float(np.max(np.abs(i_body))))):
+    if np.allclose(
+        i_body, np.diag(np.diag(i_body)), atol=1e-12 * max(1e-30, float(np.max(np.abs(i_body))))
+    ):
         return MassProperties(float(mass), c_body, np.diag(i_body).copy(), np.array([0, 0, 0, 1.0]))
     return MassProperties(float(mass), c_body, w, Rotation.from_matrix(vec).as_quat())
 
@@ -112,7 +120,9 @@ class UrdfModel:
     joints: list[JointInfo]  #: every joint, file order (fixed ones too, type "fixed")
     movable: list[JointInfo] = field(default_factory=list)  #: movable joints, file order
     mimic: list[str] = field(default_factory=list)
-    masses: dict[str, float] = field(default_factory=dict)  #: link -> <inertial> mass (links that have one)
+    masses: dict[str, float] = field(
+        default_factory=dict
+    )  #: link -> <inertial> mass (links that have one)
 
     @property
     def total_mass(self) -> float:
@@ -227,7 +237,9 @@ def parse_urdf(path: str | Path) -> UrdfModel:
             "joints); drive those joints explicitly",
             stacklevel=3,
         )
-    m = UrdfModel(path=path, root_link=roots[0], links=links, joints=joints, mimic=mimic, masses=masses)
+    m = UrdfModel(
+        path=path, root_link=roots[0], links=links, joints=joints, mimic=mimic, masses=masses
+    )
     m.movable = [j for j in joints if j.type in MOVABLE]
     return m
 

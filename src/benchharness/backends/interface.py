@@ -19,9 +19,10 @@ the normal force is about the box's weight.
 from __future__ import annotations
 
 import abc
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import ClassVar, Sequence
+from typing import ClassVar
 
 import numpy as np
 
@@ -70,7 +71,9 @@ class Capabilities:
     mesh_collision: bool = True  #: convex mesh collision shapes
     joint_friction: bool = True  #: :meth:`Backend.set_joint_friction`
     mimic_joints: bool = False  #: URDF ``<mimic>`` enforced by the engine
-    gravity_torques: bool = False  #: :meth:`Backend.gravity_torques` (the engine's own inverse dynamics)
+    gravity_torques: bool = (
+        False  #: :meth:`Backend.gravity_torques` (the engine's own inverse dynamics)
+    )
 
 
 @dataclass(frozen=True)
@@ -88,7 +91,9 @@ class PhysicsConfig:
     #: needs at 1/240 s for accurate twists; SAPIEN/PhysX TGS 20).
     solver_iterations: int | None = None
     solver_velocity_iterations: int = 1
-    contact_offset: float = 0.002  #: SAPIEN/PhysX contact offset (m); 1 cm default is too large here
+    contact_offset: float = (
+        0.002  #: SAPIEN/PhysX contact offset (m); 1 cm default is too large here
+    )
     default_friction: float = 1.0
     #: PyBullet only: torsional friction arm (m) of every contact, as Bullet's ``spinningFriction``
     #: (a pair gets this times the pair's friction coefficient). Bullet's point contacts have next to no
@@ -211,7 +216,7 @@ class Backend(abc.ABC):
     def close(self) -> None:
         """Release the engine's resources. Safe to call twice."""
 
-    def __enter__(self) -> "Backend":
+    def __enter__(self) -> Backend:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -279,8 +284,9 @@ class Backend(abc.ABC):
         """Linear (m/s) and angular (rad/s) velocity of the base, in the world frame."""
 
     @abc.abstractmethod
-    def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
-        ...
+    def set_velocity(
+        self, body: BodyId, linear: Sequence[float], angular: Sequence[float]
+    ) -> None: ...
 
     @abc.abstractmethod
     def get_link_pose(self, body: BodyId, link: str | None) -> Pose:
@@ -299,12 +305,10 @@ class Backend(abc.ABC):
         return [j.name for j in self.joint_info(body)]
 
     @abc.abstractmethod
-    def link_names(self, body: BodyId) -> list[str]:
-        ...
+    def link_names(self, body: BodyId) -> list[str]: ...
 
     @abc.abstractmethod
-    def get_joint_state(self, body: BodyId) -> JointState:
-        ...
+    def get_joint_state(self, body: BodyId) -> JointState: ...
 
     @abc.abstractmethod
     def set_joint_positions(
@@ -351,7 +355,9 @@ class Backend(abc.ABC):
         raise CapabilityError(f"backend {self.name!r} cannot compute gravity torques")
 
     @abc.abstractmethod
-    def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
+    def set_joint_friction(
+        self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None
+    ) -> None:
         """A constant Coulomb friction torque (N·m) at passive joints.
 
         Both engines model it as a velocity drive with target 0 capped at the
@@ -398,8 +404,7 @@ class Backend(abc.ABC):
         """A fixed constraint holding ``child`` at ``child_in_parent``; returns its handle."""
 
     @abc.abstractmethod
-    def detach(self, constraint: int) -> None:
-        ...
+    def detach(self, constraint: int) -> None: ...
 
     def render(self, camera: CameraSpec) -> np.ndarray:
         """An RGB image (height, width, 3) uint8. Backends without a renderer raise."""
@@ -410,5 +415,9 @@ class Backend(abc.ABC):
         for b in bodies:
             pose = self.get_pose(b)
             lin, ang = self.get_velocity(b)
-            if not (np.all(np.isfinite(pose.p)) and np.all(np.isfinite(lin)) and np.all(np.isfinite(ang))):
+            if not (
+                np.all(np.isfinite(pose.p))
+                and np.all(np.isfinite(lin))
+                and np.all(np.isfinite(ang))
+            ):
                 raise SimulationError(f"body {b} has a non-finite state (simulation blew up)")

@@ -20,23 +20,23 @@ from __future__ import annotations
 import math
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
+import pybullet as pb
 
 from ..geometry import Pose
 from . import PYBULLET_CAPABILITIES
 from ._drives import as_array, drive_command, joint_indices
-from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, mass_properties, parse_urdf
+from ._urdf import MassProperties, UrdfModel, ground_ray_fixup, mass_properties, parse_urdf
 from .interface import (
     Backend,
     BackendError,
     BodyId,
     Box,
     CameraSpec,
-    Capabilities,
     Contact,
     Cylinder,
     JointInfo,
@@ -48,8 +48,6 @@ from .interface import (
     SimulationError,
     Sphere,
 )
-
-import pybullet as pb
 
 #: a base speed above this (m/s or rad/s) counts as a blow-up, as does a non-finite state
 MAX_SPEED = 1.0e4
@@ -80,13 +78,19 @@ class _Body:
     q_prev: np.ndarray | None = None  #: joint positions at the start of the last driven step
     q_prev_step: int = -10
     driven_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
-    minv: np.ndarray | None = None  #: cached inverse mass matrix (see PyBulletBackend._mass_inverse)
+    minv: np.ndarray | None = (
+        None  #: cached inverse mass matrix (see PyBulletBackend._mass_inverse)
+    )
     minv_q: np.ndarray | None = None  #: joint positions it was computed at
     meff: np.ndarray | None = None  #: 1 / diag(minv) of the movable joints
-    gravity_base: np.ndarray | None = None  #: world gravity in a fixed base's inertial frame (cached)
+    gravity_base: np.ndarray | None = (
+        None  #: world gravity in a fixed base's inertial frame (cached)
+    )
     driven_pb: list[int] = field(default_factory=list)
     ones: list[float] = field(default_factory=list)  #: velocity gains (1.0) for driven_pb
-    drive_cache: tuple | None = None  #: per-step constants of the drive law (cleared by set_joint_targets)
+    drive_cache: tuple | None = (
+        None  #: per-step constants of the drive law (cleared by set_joint_targets)
+    )
     temp_files: list[str] = field(default_factory=list)
     jmap: dict[str, int] = field(default_factory=dict)  #: joint name -> index (see _joint_sel)
 
@@ -97,12 +101,12 @@ class _Body:
         return d
 
 
-
-
 class PyBulletBackend(Backend):
     name = "pybullet"
     capabilities = PYBULLET_CAPABILITIES
-    default_solver_iterations = 50  # DESIGN.md: >= 50 at 1/240 s, else a 90 deg twist ends at ~102 deg
+    default_solver_iterations = (
+        50  # DESIGN.md: >= 50 at 1/240 s, else a 90 deg twist ends at ~102 deg
+    )
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
         super().__init__(config)
@@ -147,7 +151,7 @@ class PyBulletBackend(Backend):
     def __del__(self) -> None:  # pragma: no cover - best effort
         try:
             self.close()
-        except Exception:
+        except Exception:  # noqa: BLE001 - interpreter shutdown: nothing to report to
             pass
 
     # -- helpers ---------------------------------------------------------------
@@ -174,7 +178,9 @@ class PyBulletBackend(Backend):
         try:
             return b.link_index[link]
         except KeyError:
-            raise BackendError(f"body {b.name!r} has no link {link!r}; links: {list(b.link_index)}") from None
+            raise BackendError(
+                f"body {b.name!r} has no link {link!r}; links: {list(b.link_index)}"
+            ) from None
 
     def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
         return joint_indices(b, joints)
@@ -196,7 +202,14 @@ class PyBulletBackend(Backend):
             self._steps += 1
             for uid, h in dynamic:
                 lin, ang = pb.getBaseVelocity(uid, physicsClientId=cid)
-                s = abs(lin[0]) + abs(lin[1]) + abs(lin[2]) + abs(ang[0]) + abs(ang[1]) + abs(ang[2])
+                s = (
+                    abs(lin[0])
+                    + abs(lin[1])
+                    + abs(lin[2])
+                    + abs(ang[0])
+                    + abs(ang[1])
+                    + abs(ang[2])
+                )
                 if not s < MAX_SPEED:  # also catches NaN
                     self._blowup(h)
         for h, b in self._bodies.items():
@@ -236,10 +249,15 @@ class PyBulletBackend(Backend):
             pb.setGravity(*gb.tolist(), physicsClientId=cid)
         try:
             if b.fixed:
-                tau = pb.calculateInverseDynamics(b.uid, list(q), list(v), [0.0] * n, physicsClientId=cid)
+                tau = pb.calculateInverseDynamics(
+                    b.uid, list(q), list(v), [0.0] * n, physicsClientId=cid
+                )
             else:
                 tau = pb.calculateInverseDynamics(
-                    b.uid, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0] + list(q), [0.0] * 6 + list(v), [0.0] * (6 + n),
+                    b.uid,
+                    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0] + list(q),
+                    [0.0] * 6 + list(v),
+                    [0.0] * (6 + n),
                     physicsClientId=cid,
                 )
         finally:
@@ -264,15 +282,21 @@ class PyBulletBackend(Backend):
         the effective inertia and free acceleration used by the drive law are
         those of the current configuration to ~0.1 %.
         """
-        if b.minv is None or b.minv_q is None or float(np.max(np.abs(q - b.minv_q))) > MASS_MATRIX_REFRESH:
-            m = np.array(pb.calculateMassMatrix(b.uid, q.tolist(), physicsClientId=self._cid), dtype=float)
+        if (
+            b.minv is None
+            or b.minv_q is None
+            or float(np.max(np.abs(q - b.minv_q))) > MASS_MATRIX_REFRESH
+        ):
+            m = np.array(
+                pb.calculateMassMatrix(b.uid, q.tolist(), physicsClientId=self._cid), dtype=float
+            )
             try:
                 minv = np.linalg.inv(m)
             except np.linalg.LinAlgError:
                 minv = np.diag(1.0 / np.maximum(np.diag(m), 1e-12))
             n = len(q)
             b.minv, b.minv_q = minv, q.copy()
-            b.meff = 1.0 / np.diag(minv)[m.shape[0] - n:]
+            b.meff = 1.0 / np.diag(minv)[m.shape[0] - n :]
         return b.minv, b.meff
 
     def _apply_drives(self, b: _Body) -> None:
@@ -333,8 +357,13 @@ class PyBulletBackend(Backend):
         # unstable (period-2 chatter) on light links in contact
         f = np.minimum(np.maximum(c * np.abs(vt), m * c * np.abs(vt - vref) / mdc), fmax)
         pb.setJointMotorControlArray(
-            b.uid, b.driven_pb, pb.VELOCITY_CONTROL, targetVelocities=vnext.tolist(), forces=f.tolist(),
-            velocityGains=b.ones, physicsClientId=self._cid,
+            b.uid,
+            b.driven_pb,
+            pb.VELOCITY_CONTROL,
+            targetVelocities=vnext.tolist(),
+            forces=f.tolist(),
+            velocityGains=b.ones,
+            physicsClientId=self._cid,
         )
 
     def _spinning(self, friction: float) -> float:
@@ -350,26 +379,47 @@ class PyBulletBackend(Backend):
         cid = self._cid
         shape = pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=[0, 0, 1], physicsClientId=cid)
         vis = pb.createVisualShape(
-            pb.GEOM_BOX, halfExtents=[5, 5, 0.0005], visualFramePosition=[0, 0, -0.0005],
-            rgbaColor=[0.8, 0.8, 0.8, 1], physicsClientId=cid,
+            pb.GEOM_BOX,
+            halfExtents=[5, 5, 0.0005],
+            visualFramePosition=[0, 0, -0.0005],
+            rgbaColor=[0.8, 0.8, 0.8, 1],
+            physicsClientId=cid,
         )
         uid = pb.createMultiBody(0.0, shape, vis, basePosition=[0, 0, height], physicsClientId=cid)
         fr = self.config.default_friction if friction is None else friction
-        pb.changeDynamics(uid, -1, lateralFriction=fr, spinningFriction=self._spinning(fr), physicsClientId=cid)
+        pb.changeDynamics(
+            uid, -1, lateralFriction=fr, spinningFriction=self._spinning(fr), physicsClientId=cid
+        )
         h = self._register(_Body(uid, "ground", None, {}, [], [], Pose(), True))
         self._grounds[h] = float(height)
         return h
 
     def _shape_args(self, s: Shape, tmp: list[str]) -> dict:
-        base = {"collisionFramePosition": s.pose.p.tolist(), "collisionFrameOrientation": s.pose.q.tolist()}
+        base = {
+            "collisionFramePosition": s.pose.p.tolist(),
+            "collisionFrameOrientation": s.pose.q.tolist(),
+        }
         if isinstance(s, Box):
-            return {"shapeType": pb.GEOM_BOX, "halfExtents": list(map(float, s.half_extents)), **base}
+            return {
+                "shapeType": pb.GEOM_BOX,
+                "halfExtents": list(map(float, s.half_extents)),
+                **base,
+            }
         if isinstance(s, Sphere):
             return {"shapeType": pb.GEOM_SPHERE, "radius": float(s.radius), **base}
         if isinstance(s, Cylinder):
-            return {"shapeType": pb.GEOM_CYLINDER, "radius": float(s.radius), "height": 2.0 * float(s.half_length), **base}
+            return {
+                "shapeType": pb.GEOM_CYLINDER,
+                "radius": float(s.radius),
+                "height": 2.0 * float(s.half_length),
+                **base,
+            }
         if isinstance(s, MeshShape):
-            return {"shapeType": pb.GEOM_MESH, "vertices": np.asarray(s.vertices, dtype=float).tolist(), **base}
+            return {
+                "shapeType": pb.GEOM_MESH,
+                "vertices": np.asarray(s.vertices, dtype=float).tolist(),
+                **base,
+            }
         raise BackendError(f"unknown shape {type(s).__name__}")
 
     def add_body(
@@ -410,14 +460,21 @@ class PyBulletBackend(Backend):
             uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
         )
         fr = self.config.default_friction if friction is None else friction
-        kw = {"lateralFriction": fr, "spinningFriction": self._spinning(fr), "linearDamping": 0.0,
-              "angularDamping": 0.0, "frictionAnchor": 1}
+        kw = {
+            "lateralFriction": fr,
+            "spinningFriction": self._spinning(fr),
+            "linearDamping": 0.0,
+            "angularDamping": 0.0,
+            "frictionAnchor": 1,
+        }
         if not fixed:
             kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
         pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
         if vis >= 0:
             pb.changeVisualShape(uid, -1, rgbaColor=[0.45, 0.5, 0.6, 1], physicsClientId=cid)
-        return self._register(_Body(uid, name or "", None, {}, [], [], mp.inertial_pose, fixed, temp_files=tmp))
+        return self._register(
+            _Body(uid, name or "", None, {}, [], [], mp.inertial_pose, fixed, temp_files=tmp)
+        )
 
     def _shape_arrays(self, shapes: list[Shape], tmp: list[str]) -> tuple[list, ...]:
         """Per-shape fields for PyBullet's ``create*ShapeArray`` calls (collision and visual alike).
@@ -433,7 +490,13 @@ class PyBulletBackend(Backend):
             elif isinstance(s, Sphere):
                 fields = (pb.GEOM_SPHERE, [0, 0, 0], float(s.radius), 0.0, "")
             elif isinstance(s, Cylinder):
-                fields = (pb.GEOM_CYLINDER, [0, 0, 0], float(s.radius), 2.0 * float(s.half_length), "")
+                fields = (
+                    pb.GEOM_CYLINDER,
+                    [0, 0, 0],
+                    float(s.radius),
+                    2.0 * float(s.half_length),
+                    "",
+                )
             else:
                 raise BackendError(f"unknown shape {type(s).__name__}")
             for column, value in zip((types, half, radii, lengths, files), fields):
@@ -447,9 +510,15 @@ class PyBulletBackend(Backend):
         types, half, radii, lengths, files, poss, orns = arrays
         scales = [[1, 1, 1]] * len(types)
         return pb.createCollisionShapeArray(
-            shapeTypes=types, halfExtents=half, radii=radii, lengths=lengths,
-            fileNames=files, meshScales=scales,
-            collisionFramePositions=poss, collisionFrameOrientations=orns, physicsClientId=cid,
+            shapeTypes=types,
+            halfExtents=half,
+            radii=radii,
+            lengths=lengths,
+            fileNames=files,
+            meshScales=scales,
+            collisionFramePositions=poss,
+            collisionFrameOrientations=orns,
+            physicsClientId=cid,
         )
 
     def _visuals(self, arrays: tuple[list, ...]) -> int:
@@ -457,9 +526,15 @@ class PyBulletBackend(Backend):
         types, half, radii, lengths, files, poss, orns = arrays
         try:
             return pb.createVisualShapeArray(
-                shapeTypes=types, halfExtents=half, radii=radii, lengths=lengths, fileNames=files,
-                meshScales=[[1, 1, 1]] * len(types), visualFramePositions=poss,
-                visualFrameOrientations=orns, physicsClientId=self._cid,
+                shapeTypes=types,
+                halfExtents=half,
+                radii=radii,
+                lengths=lengths,
+                fileNames=files,
+                meshScales=[[1, 1, 1]] * len(types),
+                visualFramePositions=poss,
+                visualFrameOrientations=orns,
+                physicsClientId=self._cid,
             )
         except pb.error:  # rendering is a nicety; physics does not need it
             return -1
@@ -490,7 +565,11 @@ class PyBulletBackend(Backend):
     ) -> BodyId:
         cid = self._cid
         model = parse_urdf(path)
-        flags = pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_IMPLICIT_CYLINDER
+        flags = (
+            pb.URDF_USE_INERTIA_FROM_FILE
+            | pb.URDF_USE_SELF_COLLISION
+            | pb.URDF_USE_IMPLICIT_CYLINDER
+        )
         try:
             uid = pb.loadURDF(
                 str(Path(path).resolve()),
@@ -511,14 +590,22 @@ class PyBulletBackend(Backend):
         jidx = [joint_by_name[j.name] for j in joints]
         # default motors off; URDF friction/damping are not used (set_joint_friction instead)
         if jidx:
-            pb.setJointMotorControlArray(uid, jidx, pb.VELOCITY_CONTROL, forces=[0.0] * len(jidx), physicsClientId=cid)
+            pb.setJointMotorControlArray(
+                uid, jidx, pb.VELOCITY_CONTROL, forces=[0.0] * len(jidx), physicsClientId=cid
+            )
         for i in range(-1, pb.getNumJoints(uid, physicsClientId=cid)):
             pb.changeDynamics(
-                uid, i, linearDamping=0.0, angularDamping=0.0, jointDamping=0.0,
+                uid,
+                i,
+                linearDamping=0.0,
+                angularDamping=0.0,
+                jointDamping=0.0,
                 lateralFriction=float(self.config.default_friction),
-                spinningFriction=self._spinning(float(self.config.default_friction)), frictionAnchor=1,
+                spinningFriction=self._spinning(float(self.config.default_friction)),
+                frictionAnchor=1,
                 physicsClientId=cid,
             )
+
         # filter pairs adjacent through fixed links (PhysX does not, we do on both engines)
         def idx(l: str) -> int:
             return -1 if l == model.root_link else link_index[l]
@@ -527,14 +614,28 @@ class PyBulletBackend(Backend):
             ls = sorted(clique)
             for a in range(len(ls)):
                 for c in range(a + 1, len(ls)):
-                    pb.setCollisionFilterPair(uid, uid, idx(ls[a]), idx(ls[c]), 0, physicsClientId=cid)
+                    pb.setCollisionFilterPair(
+                        uid, uid, idx(ls[a]), idx(ls[c]), 0, physicsClientId=cid
+                    )
         di = pb.getDynamicsInfo(uid, -1, physicsClientId=cid)
         base_inertial = Pose(di[3], di[4])
         n = len(joints)
         b = _Body(
-            uid, name or model.root_link, model, link_index, joints, jidx, base_inertial, bool(fixed_base),
-            target_q=np.zeros(n), target_v=np.zeros(n), kp=np.zeros(n), kd=np.zeros(n),
-            fmax=np.zeros(n), driven=np.zeros(n, dtype=bool), friction=np.zeros(n),
+            uid,
+            name or model.root_link,
+            model,
+            link_index,
+            joints,
+            jidx,
+            base_inertial,
+            bool(fixed_base),
+            target_q=np.zeros(n),
+            target_v=np.zeros(n),
+            kp=np.zeros(n),
+            kd=np.zeros(n),
+            fmax=np.zeros(n),
+            driven=np.zeros(n, dtype=bool),
+            friction=np.zeros(n),
         )
         h = self._register(b)
         self.set_pose(h, base_pose)
@@ -565,7 +666,9 @@ class PyBulletBackend(Backend):
         b = self._b(body)
         b.gravity_base = None
         lin, ang = pb.getBaseVelocity(b.uid, physicsClientId=self._cid)
-        pb.resetBasePositionAndOrientation(b.uid, *self._com_pose_of(pose, b.base_inertial), physicsClientId=self._cid)
+        pb.resetBasePositionAndOrientation(
+            b.uid, *self._com_pose_of(pose, b.base_inertial), physicsClientId=self._cid
+        )
         pb.resetBaseVelocity(b.uid, lin, ang, physicsClientId=self._cid)
 
     def get_velocity(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
@@ -575,7 +678,9 @@ class PyBulletBackend(Backend):
 
     def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
         b = self._b(body)
-        pb.resetBaseVelocity(b.uid, list(map(float, linear)), list(map(float, angular)), physicsClientId=self._cid)
+        pb.resetBaseVelocity(
+            b.uid, list(map(float, linear)), list(map(float, angular)), physicsClientId=self._cid
+        )
 
     def get_link_pose(self, body: BodyId, link: str | None) -> Pose:
         b = self._b(body)
@@ -590,7 +695,10 @@ class PyBulletBackend(Backend):
         if b.urdf is not None:  # engines zero a fixed base's mass; report the description's
             return b.urdf.total_mass
         return float(
-            sum(pb.getDynamicsInfo(b.uid, i, physicsClientId=self._cid)[0] for i in range(-1, pb.getNumJoints(b.uid, physicsClientId=self._cid)))
+            sum(
+                pb.getDynamicsInfo(b.uid, i, physicsClientId=self._cid)[0]
+                for i in range(-1, pb.getNumJoints(b.uid, physicsClientId=self._cid))
+            )
         )
 
     # -- joints ----------------------------------------------------------------
@@ -611,7 +719,9 @@ class PyBulletBackend(Backend):
             np.array([s[0] for s in st]), np.array([s[1] for s in st]), np.array([s[3] for s in st])
         )
 
-    def set_joint_positions(self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None) -> None:
+    def set_joint_positions(
+        self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
+    ) -> None:
         b = self._b(body)
         sel = self._joint_sel(b, joints)
         pos = as_array(positions, len(sel), "positions")
@@ -637,7 +747,13 @@ class PyBulletBackend(Backend):
         if n == 0:
             return
         cmd = drive_command(
-            b.joints, sel, positions, velocities, stiffness, damping, force_limit,
+            b.joints,
+            sel,
+            positions,
+            velocities,
+            stiffness,
+            damping,
+            force_limit,
             lambda: self.get_joint_state(body).positions,
         )
         q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
@@ -648,7 +764,9 @@ class PyBulletBackend(Backend):
         b.ones = [1.0] * len(b.driven_pb)
         b.drive_cache = None
 
-    def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
+    def set_joint_friction(
+        self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None
+    ) -> None:
         b = self._b(body)
         sel = self._joint_sel(b, joints)
         t = as_array(torques, len(sel), "torques")
@@ -656,8 +774,13 @@ class PyBulletBackend(Backend):
             b.friction[i] = float(tau)
             if not b.driven[i]:
                 pb.setJointMotorControl2(
-                    b.uid, b.joint_index[i], pb.VELOCITY_CONTROL, targetVelocity=0.0, force=float(tau),
-                    velocityGain=1.0, physicsClientId=self._cid,
+                    b.uid,
+                    b.joint_index[i],
+                    pb.VELOCITY_CONTROL,
+                    targetVelocity=0.0,
+                    force=float(tau),
+                    velocityGain=1.0,
+                    physicsClientId=self._cid,
                 )
 
     # -- interaction -----------------------------------------------------------
@@ -676,9 +799,16 @@ class PyBulletBackend(Backend):
             pos = 0.5 * (np.asarray(c[5]) + np.asarray(c[6]))
             nrm = np.asarray(c[7], dtype=float)
             con = Contact(a, la, bb, lb, pos, nrm, max(0.0, float(c[9])), float(c[8]))
-            if (body_a is not None and a != body_a) or (body_a is None and body_b is not None and bb != body_b):
+            if (body_a is not None and a != body_a) or (
+                body_a is None and body_b is not None and bb != body_b
+            ):
                 con = Contact(bb, lb, a, la, pos, -nrm, con.normal_force, con.distance)
-            if body_a is not None and con.body_a != body_a or body_b is not None and con.body_b != body_b:
+            if (
+                body_a is not None
+                and con.body_a != body_a
+                or body_b is not None
+                and con.body_b != body_b
+            ):
                 continue
             out.append(con)
         return out
@@ -753,9 +883,16 @@ class PyBulletBackend(Backend):
         fp = pin.inv() * child_in_parent
         fc = cin.inv()
         cid = pb.createConstraint(
-            pbody.uid, pi, cbody.uid, ci, pb.JOINT_FIXED, [0, 0, 0],
-            parentFramePosition=fp.p.tolist(), childFramePosition=fc.p.tolist(),
-            parentFrameOrientation=fp.q.tolist(), childFrameOrientation=fc.q.tolist(),
+            pbody.uid,
+            pi,
+            cbody.uid,
+            ci,
+            pb.JOINT_FIXED,
+            [0, 0, 0],
+            parentFramePosition=fp.p.tolist(),
+            childFramePosition=fc.p.tolist(),
+            parentFrameOrientation=fp.q.tolist(),
+            childFrameOrientation=fc.q.tolist(),
             physicsClientId=self._cid,
         )
         pb.changeConstraint(cid, maxForce=_ATTACH_MAX_FORCE, physicsClientId=self._cid)
@@ -774,7 +911,9 @@ class PyBulletBackend(Backend):
                 for st in pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid):
                     vals += [st[0], st[1]]
             if not all(math.isfinite(v) for v in vals):
-                raise SimulationError(f"body {b.name!r} (handle {h}) has a non-finite state (simulation blew up)")
+                raise SimulationError(
+                    f"body {b.name!r} (handle {h}) has a non-finite state (simulation blew up)"
+                )
 
     def _inertial(self, b: _Body, link: int) -> Pose:
         if link == -1:
@@ -792,10 +931,19 @@ class PyBulletBackend(Backend):
     def render(self, camera: CameraSpec) -> np.ndarray:
         view = pb.computeViewMatrix(camera.eye, camera.target, camera.up, physicsClientId=self._cid)
         proj = pb.computeProjectionMatrixFOV(
-            camera.fov_deg, camera.width / camera.height, camera.near, camera.far, physicsClientId=self._cid
+            camera.fov_deg,
+            camera.width / camera.height,
+            camera.near,
+            camera.far,
+            physicsClientId=self._cid,
         )
         _, _, rgba, _, _ = pb.getCameraImage(
-            camera.width, camera.height, view, proj, renderer=pb.ER_TINY_RENDERER, physicsClientId=self._cid
+            camera.width,
+            camera.height,
+            view,
+            proj,
+            renderer=pb.ER_TINY_RENDERER,
+            physicsClientId=self._cid,
         )
         img = np.asarray(rgba, dtype=np.uint8).reshape(camera.height, camera.width, 4)
         return img[:, :, :3].copy()

@@ -22,22 +22,29 @@ import math
 import os
 import tempfile
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
 from ..geometry import Pose
 from . import SAPIEN_CAPABILITIES
 from ._drives import as_array, drive_command, joint_indices
-from ._urdf import MassProperties, ground_ray_fixup, UrdfModel, collision_only_copy, mass_properties, parse_urdf
+from ._urdf import (
+    MassProperties,
+    UrdfModel,
+    collision_only_copy,
+    ground_ray_fixup,
+    mass_properties,
+    parse_urdf,
+)
 from .interface import (
     Backend,
     BackendError,
     BodyId,
     Box,
-    Capabilities,
     Contact,
     Cylinder,
     JointInfo,
@@ -65,12 +72,14 @@ _ATTACH_MAX_FORCE = 1.0e5
 _X_TO_Z = Pose([0, 0, 0], [0.0, -math.sqrt(0.5), 0.0, math.sqrt(0.5)])
 
 
-def _sp(pose: Pose) -> "sapien.Pose":
+def _sp(pose: Pose) -> sapien.Pose:
     q = pose.q
-    return sapien.Pose([float(x) for x in pose.p], [float(q[3]), float(q[0]), float(q[1]), float(q[2])])
+    return sapien.Pose(
+        [float(x) for x in pose.p], [float(q[3]), float(q[0]), float(q[1]), float(q[2])]
+    )
 
 
-def _bp(pose: "sapien.Pose") -> Pose:
+def _bp(pose: sapien.Pose) -> Pose:
     q = pose.q
     return Pose(np.asarray(pose.p, dtype=float), [q[1], q[2], q[3], q[0]])
 
@@ -86,7 +95,9 @@ class _Body:
     links: dict[str, Any] = field(default_factory=dict)  #: URDF name -> link component
     joints: list[JointInfo] = field(default_factory=list)
     sjoints: list[Any] = field(default_factory=list)  #: SAPIEN joints in our order
-    perm: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  #: ours -> active index
+    perm: np.ndarray = field(
+        default_factory=lambda: np.zeros(0, dtype=int)
+    )  #: ours -> active index
     fixed: bool = False
     driven: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     target_q: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -96,7 +107,9 @@ class _Body:
     fmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
     friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
     drive_props: dict[int, tuple[float, float, float]] = field(default_factory=dict)
-    drive_targets: dict[int, tuple[float, float]] = field(default_factory=dict)  #: last (q*, v*) sent
+    drive_targets: dict[int, tuple[float, float]] = field(
+        default_factory=dict
+    )  #: last (q*, v*) sent
     gravity_tree: Any = None  #: cached (links, downstream mask, prismatic, masses) for a free base
     temp_files: list[str] = field(default_factory=list)
     jmap: dict[str, int] = field(default_factory=dict)  #: joint name -> index (see _joint_sel)
@@ -111,17 +124,19 @@ class _Body:
         return [self.component]
 
 
-
-
 class SapienBackend(Backend):
     name = "sapien"
     capabilities = SAPIEN_CAPABILITIES
-    default_solver_iterations = 20  # DESIGN.md spike: TGS with 20 position iterations twists the cube correctly
+    default_solver_iterations = (
+        20  # DESIGN.md spike: TGS with 20 position iterations twists the cube correctly
+    )
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
         super().__init__(config)
         c = self.config
-        physx.set_scene_config(gravity=np.asarray(c.gravity, dtype=np.float32), enable_tgs=True, cpu_workers=0)
+        physx.set_scene_config(
+            gravity=np.asarray(c.gravity, dtype=np.float32), enable_tgs=True, cpu_workers=0
+        )
         self._apply_global_config()
         self._system = physx.PhysxCpuSystem()
         self._scene = sapien.Scene([self._system])
@@ -190,7 +205,9 @@ class SapienBackend(Backend):
         try:
             return b.links[link]
         except KeyError:
-            raise BackendError(f"body {b.name!r} has no link {link!r}; links: {list(b.links)}") from None
+            raise BackendError(
+                f"body {b.name!r} has no link {link!r}; links: {list(b.links)}"
+            ) from None
 
     def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
         return joint_indices(b, joints)
@@ -269,11 +286,15 @@ class SapienBackend(Backend):
         tmp: list[str] = []
         for s in shapes:
             if isinstance(s, Box):
-                builder.add_box_collision(_sp(s.pose), [float(x) for x in s.half_extents], material=mat)
+                builder.add_box_collision(
+                    _sp(s.pose), [float(x) for x in s.half_extents], material=mat
+                )
             elif isinstance(s, Sphere):
                 builder.add_sphere_collision(_sp(s.pose), float(s.radius), material=mat)
             elif isinstance(s, Cylinder):
-                builder.add_cylinder_collision(_sp(s.pose * _X_TO_Z), float(s.radius), float(s.half_length), material=mat)
+                builder.add_cylinder_collision(
+                    _sp(s.pose * _X_TO_Z), float(s.radius), float(s.half_length), material=mat
+                )
             elif isinstance(s, MeshShape):
                 import trimesh
 
@@ -292,7 +313,9 @@ class SapienBackend(Backend):
             ent = builder.build_static(name=nm)
             comp = ent.find_component_by_type(physx.PhysxRigidStaticComponent)
         else:
-            builder.set_mass_and_inertia(float(mass), _sp(mp.inertial_pose), [float(x) for x in mp.inertia_diag])
+            builder.set_mass_and_inertia(
+                float(mass), _sp(mp.inertial_pose), [float(x) for x in mp.inertia_diag]
+            )
             ent = builder.build(name=nm)
             comp = ent.find_component_by_type(physx.PhysxRigidDynamicComponent)
             comp.linear_damping = 0.0  # no artificial damping (PhysX defaults to 0.05 angular)
@@ -318,7 +341,7 @@ class SapienBackend(Backend):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 art = loader.load(copy, srdf_file="")
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             raise BackendError(f"SAPIEN could not load {path}: {exc}") from exc
         finally:
             try:
@@ -348,7 +371,10 @@ class SapienBackend(Backend):
                 shape.set_collision_groups(g)
         for bit, clique in enumerate(cliques):
             if bit >= 32:
-                warnings.warn(f"{path}: more than 32 fixed-link collision filters; the rest are not applied")
+                warnings.warn(
+                    f"{path}: more than 32 fixed-link collision filters; the rest are not applied",
+                    stacklevel=2,
+                )
                 break
             for ln in clique:
                 for shape in links[ln].collision_shapes:
@@ -357,10 +383,22 @@ class SapienBackend(Backend):
                     shape.set_collision_groups(g)
         n = len(joints)
         b = _Body(
-            h, name or model.root_link, articulation=art, urdf=model, links=links, joints=joints,
-            sjoints=sjoints, perm=perm, fixed=bool(fixed_base),
-            driven=np.zeros(n, dtype=bool), target_q=np.zeros(n), target_v=np.zeros(n), kp=np.zeros(n),
-            kd=np.zeros(n), fmax=np.zeros(n), friction=np.zeros(n),
+            h,
+            name or model.root_link,
+            articulation=art,
+            urdf=model,
+            links=links,
+            joints=joints,
+            sjoints=sjoints,
+            perm=perm,
+            fixed=bool(fixed_base),
+            driven=np.zeros(n, dtype=bool),
+            target_q=np.zeros(n),
+            target_v=np.zeros(n),
+            kp=np.zeros(n),
+            kd=np.zeros(n),
+            fmax=np.zeros(n),
+            friction=np.zeros(n),
         )
         art.set_root_pose(_sp(base_pose))
         art.set_qpos(np.zeros(art.dof, dtype=np.float32))
@@ -368,7 +406,7 @@ class SapienBackend(Backend):
 
     def remove_body(self, body: BodyId) -> None:
         b = self._b(body)
-        for c, (drive, pb_, cb_) in list(self._constraints.items()):
+        for c, (_drive, pb_, cb_) in list(self._constraints.items()):
             if body in (pb_, cb_):
                 self.detach(c)
         if b.articulation is not None:
@@ -404,7 +442,9 @@ class SapienBackend(Backend):
         if b.fixed and b.articulation is None:
             return np.zeros(3), np.zeros(3)
         r = b.root
-        return np.asarray(r.linear_velocity, dtype=float), np.asarray(r.angular_velocity, dtype=float)
+        return np.asarray(r.linear_velocity, dtype=float), np.asarray(
+            r.angular_velocity, dtype=float
+        )
 
     def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
         b = self._b(body)
@@ -454,7 +494,9 @@ class SapienBackend(Backend):
         )
         return JointState(q, v, eff)
 
-    def set_joint_positions(self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None) -> None:
+    def set_joint_positions(
+        self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
+    ) -> None:
         b = self._b(body)
         sel = self._joint_sel(b, joints)
         pos = as_array(positions, len(sel), "positions")
@@ -484,7 +526,13 @@ class SapienBackend(Backend):
         if n == 0:
             return
         cmd = drive_command(
-            b.joints, sel, positions, velocities, stiffness, damping, force_limit,
+            b.joints,
+            sel,
+            positions,
+            velocities,
+            stiffness,
+            damping,
+            force_limit,
             lambda: self.get_joint_state(body).positions,
         )
         q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
@@ -493,7 +541,9 @@ class SapienBackend(Backend):
         # PhysX keeps drive settings until changed: only changed values are sent (a held robot
         # re-sends the same targets every control tick, and each setter is a C++ call)
         props, targets = b.drive_props, b.drive_targets
-        for i, qi, vi, ki, di, fi in zip(sel.tolist(), q.tolist(), v.tolist(), k.tolist(), d.tolist(), f.tolist()):
+        for i, qi, vi, ki, di, fi in zip(
+            sel.tolist(), q.tolist(), v.tolist(), k.tolist(), d.tolist(), f.tolist()
+        ):
             j = b.sjoints[i]
             prop = (ki, di, fi)
             if props.get(i) != prop:
@@ -546,7 +596,9 @@ class SapienBackend(Backend):
         g = np.asarray(self.config.gravity, dtype=float)
         com = np.array([_bp(l.entity_pose * l.cmass_local_pose).p for l in links])
         frames = [_bp(j.get_global_pose()) for j in b.sjoints]
-        axis = np.array([f.rotation.as_matrix()[:, 0] for f in frames])  # PhysX joints move along/about x
+        axis = np.array(
+            [f.rotation.as_matrix()[:, 0] for f in frames]
+        )  # PhysX joints move along/about x
         origin = np.array([f.p for f in frames])
         m_down = down @ mass
         moment = down @ (mass[:, None] * com) - m_down[:, None] * origin
@@ -554,7 +606,9 @@ class SapienBackend(Backend):
         tau[prism] = -m_down[prism] * (axis[prism] @ g)
         return tau
 
-    def set_joint_friction(self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None) -> None:
+    def set_joint_friction(
+        self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None
+    ) -> None:
         b = self._b(body)
         sel = self._joint_sel(b, joints)
         t = as_array(torques, len(sel), "torques")
@@ -584,7 +638,9 @@ class SapienBackend(Backend):
                 continue
             # PhysX: the normal points from the second body towards the first
             (ha, la), (hb, lb), sign = e0, e1, 1.0
-            if (body_a is not None and ha != body_a) or (body_a is None and body_b is not None and hb != body_b):
+            if (body_a is not None and ha != body_a) or (
+                body_a is None and body_b is not None and hb != body_b
+            ):
                 (ha, la), (hb, lb), sign = e1, e0, -1.0
             if body_a is not None and ha != body_a:
                 continue
@@ -594,7 +650,18 @@ class SapienBackend(Backend):
                 nrm = sign * np.asarray(p.normal, dtype=float)
                 imp = np.asarray(p.impulse, dtype=float)
                 fn = abs(float(np.dot(imp, p.normal))) * inv_dt
-                out.append(Contact(ha, la, hb, lb, np.asarray(p.position, dtype=float), nrm, fn, float(p.separation)))
+                out.append(
+                    Contact(
+                        ha,
+                        la,
+                        hb,
+                        lb,
+                        np.asarray(p.position, dtype=float),
+                        nrm,
+                        fn,
+                        float(p.separation),
+                    )
+                )
         return out
 
     def ray_cast(
@@ -630,7 +697,9 @@ class SapienBackend(Backend):
                 if start >= maxd[i]:
                     break
                 org = o[i] + dvec[i] * start
-                r = self._system.raycast(org.astype(np.float32), dvec[i].astype(np.float32), float(maxd[i] - start))
+                r = self._system.raycast(
+                    org.astype(np.float32), dvec[i].astype(np.float32), float(maxd[i] - start)
+                )
                 if r is None:
                     break
                 ent = emap.get(r.component.entity.per_scene_id)
@@ -663,7 +732,9 @@ class SapienBackend(Backend):
         drive.pose_in_parent = _sp(child_in_parent)
         drive.pose_in_child = sapien.Pose()
         for ax in ("x", "y", "z"):
-            getattr(drive, f"set_drive_property_{ax}")(_ATTACH_STIFFNESS, _ATTACH_DAMPING, _ATTACH_MAX_FORCE)
+            getattr(drive, f"set_drive_property_{ax}")(
+                _ATTACH_STIFFNESS, _ATTACH_DAMPING, _ATTACH_MAX_FORCE
+            )
         drive.set_drive_property_slerp(_ATTACH_STIFFNESS, _ATTACH_DAMPING, _ATTACH_MAX_FORCE)
         drive.set_drive_target(sapien.Pose())
         ccomp.entity.add_component(drive)
@@ -693,7 +764,9 @@ class SapienBackend(Backend):
             if b.articulation is not None:
                 arrs += [b.articulation.qpos, b.articulation.qvel]
             if not all(np.all(np.isfinite(a)) for a in arrs):
-                raise SimulationError(f"body {b.name!r} (handle {h}) has a non-finite state (simulation blew up)")
+                raise SimulationError(
+                    f"body {b.name!r} (handle {h}) has a non-finite state (simulation blew up)"
+                )
 
 
 def _ray_exit(shape: Any, body_pose: Pose, origin: np.ndarray, direction: np.ndarray) -> float:

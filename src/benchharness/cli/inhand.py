@@ -25,7 +25,7 @@ def _fmt(x: float, digits: int = 3) -> str:
         return "-"
     if x == 0:
         return "0"
-    if abs(x) >= 10 ** digits:
+    if abs(x) >= 10**digits:
         return f"{x:.0f}"
     return f"{x:.{digits}g}"
 
@@ -91,22 +91,57 @@ def _discarded_rows(scored):
 
 @inhand.command("score")
 @click.argument("results_file", metavar="RESULTS", type=click.Path(path_type=Path))
-@click.option("--by", "by", default="method", show_default=True,
-              help="Comma-separated grouping columns (method, object, task_id, level, or any extra column). "
-                   "Methods are never pooled: --by object groups by method and object.")
-@click.option("--plot", "plot_path", type=click.Path(path_type=Path), default=None,
-              help="Write a Figure-7-style box plot (per object, one box per method); .png or .svg.")
-@click.option("--discarded", "show_discarded", is_flag=True,
-              help="List the trials discarded by the 10 % set-up rule (section II-B).")
-@click.option("--geodesic", type=click.Choice(["heat", "exact"]), default="heat", show_default=True,
-              help="Geodesic distances for G_geo: heat method (cached, fast) or exact (pygeodesic).")
-@click.option("--contact-tol", type=float, default=2e-3, show_default=True,
-              help="Distance (m) from the object surface within which a mesh point counts as contact.")
-@click.option("--normalize-quaternions", is_flag=True,
-              help="Normalise quaternions before eq. 3 (default: as recorded, which reproduces the paper).")
+@click.option(
+    "--by",
+    "by",
+    default="method",
+    show_default=True,
+    help="Comma-separated grouping columns (method, object, task_id, level, or any extra column). "
+    "Methods are never pooled: --by object groups by method and object.",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Write a Figure-7-style box plot (per object, one box per method); .png or .svg.",
+)
+@click.option(
+    "--discarded",
+    "show_discarded",
+    is_flag=True,
+    help="List the trials discarded by the 10 % set-up rule (section II-B).",
+)
+@click.option(
+    "--geodesic",
+    type=click.Choice(["heat", "exact"]),
+    default="heat",
+    show_default=True,
+    help="Geodesic distances for G_geo: heat method (cached, fast) or exact (pygeodesic).",
+)
+@click.option(
+    "--contact-tol",
+    type=float,
+    default=2e-3,
+    show_default=True,
+    help="Distance (m) from the object surface within which a mesh point counts as contact.",
+)
+@click.option(
+    "--normalize-quaternions",
+    is_flag=True,
+    help="Normalise quaternions before eq. 3 (default: as recorded, which reproduces the paper).",
+)
 @json_option
-def score_cmd(results_file: Path, by: str, plot_path: Path | None, show_discarded: bool, geodesic: str,
-              contact_tol: float, normalize_quaternions: bool, as_json: bool) -> None:
+def score_cmd(
+    results_file: Path,
+    by: str,
+    plot_path: Path | None,
+    show_discarded: bool,
+    geodesic: str,
+    contact_tol: float,
+    normalize_quaternions: bool,
+    as_json: bool,
+) -> None:
     """Score a recorded-results file (CSV or JSON, format in docs/inhand.md).
 
     Prints, per group, drops %, median [first quartile, third quartile] of
@@ -131,7 +166,9 @@ def score_cmd(results_file: Path, by: str, plot_path: Path | None, show_discarde
         fail(f"--plot: {plot_path} must end in .png or .svg")
     try:
         results = read_results(results_file)
-        scored = score_results(results, geodesic=geodesic, contact_tol=contact_tol, normalize=normalize_quaternions)
+        scored = score_results(
+            results, geodesic=geodesic, contact_tol=contact_tol, normalize=normalize_quaternions
+        )
         summaries = summarize(scored, [b.strip() for b in by.split(",")])
     except FileFormatError as e:
         fail(str(e))
@@ -146,10 +183,18 @@ def score_cmd(results_file: Path, by: str, plot_path: Path | None, show_discarde
         from ..metrics.inhand import summarize_scores
         from ..metrics.plots import box_plot
 
-        plot_metrics = [m for m in ("err_pos", "err_pos_percent", "err_or_percent", "g_euc", "g_geo") if m in metrics]
-        per_object = summarize_scores(scored.scores, group_columns(results), ("object", "method"), results.dropped)
+        plot_metrics = [
+            m
+            for m in ("err_pos", "err_pos_percent", "err_or_percent", "g_euc", "g_geo")
+            if m in metrics
+        ]
+        per_object = summarize_scores(
+            scored.scores, group_columns(results), ("object", "method"), results.dropped
+        )
         box_plot(
-            per_object, plot_metrics, plot_path,
+            per_object,
+            plot_metrics,
+            plot_path,
             labels={m: f"{METRICS[m].label} ({METRICS[m].unit})" for m in plot_metrics},
             scales={m: METRICS[m].scale for m in plot_metrics},
             title=results_file.name,
@@ -184,8 +229,12 @@ def score_cmd(results_file: Path, by: str, plot_path: Path | None, show_discarde
     for m in metrics:
         table.add_column(f"{METRICS[m].label} ({METRICS[m].unit})", justify="right", no_wrap=True)
     for s in summaries:
-        table.add_row(*s.key, str(s.n_trials), _fmt(s.drops_percent),
-                      *[_cell(s.stats[m], METRICS[m].scale) for m in metrics])
+        table.add_row(
+            *s.key,
+            str(s.n_trials),
+            _fmt(s.drops_percent),
+            *[_cell(s.stats[m], METRICS[m].scale) for m in metrics],
+        )
     console.print(table)
     n_disc = len(discarded)
     if has_setup:
@@ -194,21 +243,44 @@ def score_cmd(results_file: Path, by: str, plot_path: Path | None, show_discarde
         console.print("No set-up poses recorded: the 10 % set-up rule was not applied.")
     if show_discarded and n_disc:
         t = Table(title="Discarded trials (set-up error > 10 %)")
-        for c in ("method", "object", "task_id", "trial", "setup err_pos (cm)", "setup err_pos%", "setup err_or%"):
+        for c in (
+            "method",
+            "object",
+            "task_id",
+            "trial",
+            "setup err_pos (cm)",
+            "setup err_pos%",
+            "setup err_or%",
+        ):
             t.add_column(c)
         for d in discarded:
-            t.add_row(d["method"], d["object"], d["task_id"], str(d["trial"]), _fmt(d["setup_err_pos_cm"]),
-                      _fmt(d["setup_err_pos_percent"]), _fmt(d["setup_err_or_percent"]))
+            t.add_row(
+                d["method"],
+                d["object"],
+                d["task_id"],
+                str(d["trial"]),
+                _fmt(d["setup_err_pos_cm"]),
+                _fmt(d["setup_err_pos_percent"]),
+                _fmt(d["setup_err_or_percent"]),
+            )
         console.print(t)
     if plot_path is not None:
         console.print(f"Box plot written to {plot_path}")
 
 
 @inhand.command("import-bih")
-@click.option("--source", type=click.Path(path_type=Path), default=None,
-              help="The published dataset folder (default: ../shared/data/bih_dataset next to the repository).")
-@click.option("--out", type=click.Path(path_type=Path), default=None,
-              help="Output folder (default: the repository's tasks/inhand).")
+@click.option(
+    "--source",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="The published dataset folder (default: ../shared/data/bih_dataset next to the repository).",
+)
+@click.option(
+    "--out",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Output folder (default: the repository's tasks/inhand).",
+)
 @json_option
 def import_bih_cmd(source: Path | None, out: Path | None, as_json: bool) -> None:
     """Convert the published in-hand benchmark dataset (.ods) into task and results CSVs.
@@ -228,8 +300,14 @@ def import_bih_cmd(source: Path | None, out: Path | None, as_json: bool) -> None
     except BihImportError as e:
         fail(str(e))
     if as_json:
-        emit_json({"source": str(report.source), "out": str(report.out),
-                   "files": [str(f) for f in report.files], "counts": report.counts})
+        emit_json(
+            {
+                "source": str(report.source),
+                "out": str(report.out),
+                "files": [str(f) for f in report.files],
+                "counts": report.counts,
+            }
+        )
         return
     click.echo(f"Converted {report.source}")
     for f in report.files:

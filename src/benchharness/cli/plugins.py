@@ -32,7 +32,11 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
             {
                 "items": [it.describe() for it in items],
                 "errors": [
-                    {"entry_point": e.entry_point, "distribution": e.distribution, "reason": e.reason}
+                    {
+                        "entry_point": e.entry_point,
+                        "distribution": e.distribution,
+                        "reason": e.reason,
+                    }
                     for e in manager.errors
                 ],
             }

@@ -43,8 +43,13 @@ def robots_cmd(as_json: bool) -> None:
     for col in ("name", "DOF", "groups", "distribution", "summary"):
         table.add_column(col)
     for r in rows:
-        table.add_row(r["name"], str(r["dof"] if r["dof"] is not None else "?"), ", ".join(r["groups"]),
-                      r["distribution"], r["summary"])
+        table.add_row(
+            r["name"],
+            str(r["dof"] if r["dof"] is not None else "?"),
+            ", ".join(r["groups"]),
+            r["distribution"],
+            r["summary"],
+        )
     Console().print(table)
 
 
@@ -65,8 +70,15 @@ def _camera_for(points: np.ndarray):
     direction = np.array([1.0, 0.45, 0.5])
     direction /= np.linalg.norm(direction)
     eye = centre + direction * dist
-    return CameraSpec(eye=tuple(eye), target=tuple(centre), width=640, height=480, fov_deg=fov,
-                      near=0.01, far=float(dist + 3 * radius))
+    return CameraSpec(
+        eye=tuple(eye),
+        target=tuple(centre),
+        width=640,
+        height=480,
+        fov_deg=fov,
+        near=0.01,
+        far=float(dist + 3 * radius),
+    )
 
 
 def _snapshot(robot_name: str, backend_name: str, png: Path) -> str:
@@ -91,9 +103,19 @@ def _snapshot(robot_name: str, backend_name: str, png: Path) -> str:
 
 @robot.command("inspect")
 @click.argument("name")
-@click.option("--backend", "backend_name", default="pybullet", show_default=True, help="Backend to load the robot on.")
-@click.option("--png", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Save a snapshot of the robot in its home pose.")
+@click.option(
+    "--backend",
+    "backend_name",
+    default="pybullet",
+    show_default=True,
+    help="Backend to load the robot on.",
+)
+@click.option(
+    "--png",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Save a snapshot of the robot in its home pose.",
+)
 @json_option
 def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -> None:
     """Load robot NAME on a backend: DOF, joint limits, groups and tool frames in the home pose."""
@@ -121,12 +143,25 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
         "urdf": str(rob.urdf_path),
         "groups": {k: list(v) for k, v in rob.groups().items()},
         "joints": [
-            {"name": j.name, "type": j.type, "lower": j.lower, "upper": j.upper, "max_velocity": j.max_velocity,
-             "max_effort": j.max_effort, "home": float(h)}
+            {
+                "name": j.name,
+                "type": j.type,
+                "lower": j.lower,
+                "upper": j.upper,
+                "max_velocity": j.max_velocity,
+                "max_effort": j.max_effort,
+                "home": float(h),
+            }
             for j, h in zip(info, home)
         ],
-        "tcp_frames": {g: {"link": rob.tcp_links()[g], "position": p.p.tolist(), "quaternion_xyzw": p.q.tolist()}
-                       for g, p in tcp.items()},
+        "tcp_frames": {
+            g: {
+                "link": rob.tcp_links()[g],
+                "position": p.p.tolist(),
+                "quaternion_xyzw": p.q.tolist(),
+            }
+            for g, p in tcp.items()
+        },
     }
     if png is not None:
         data["png"] = str(png)
@@ -135,13 +170,22 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
         emit_json(data)
         return
     con = Console()
-    con.print(f"[bold]{rob.name}[/bold] on {backend_name}: {rob.dof} DOF, {mass:.2f} kg, {rob.urdf_path}")
+    con.print(
+        f"[bold]{rob.name}[/bold] on {backend_name}: {rob.dof} DOF, {mass:.2f} kg, {rob.urdf_path}"
+    )
     t = Table(title="joints (SI units; home = home configuration)")
     for col in ("joint", "type", "lower", "upper", "max vel", "max effort", "home"):
         t.add_column(col, justify="right" if col not in ("joint", "type") else "left")
     for j in data["joints"]:
-        t.add_row(j["name"], j["type"], f"{j['lower']:.4f}", f"{j['upper']:.4f}", f"{j['max_velocity']:.3f}",
-                  f"{j['max_effort']:.1f}", f"{j['home']:.3f}")
+        t.add_row(
+            j["name"],
+            j["type"],
+            f"{j['lower']:.4f}",
+            f"{j['upper']:.4f}",
+            f"{j['max_velocity']:.3f}",
+            f"{j['max_effort']:.1f}",
+            f"{j['home']:.3f}",
+        )
     con.print(t)
     g = Table(title="groups")
     g.add_column("group")
@@ -153,10 +197,19 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
     for col in ("group", "link", "position (m)", "quaternion"):
         f.add_column(col)
     for k, v in data["tcp_frames"].items():
-        f.add_row(k, v["link"], np.array2string(np.asarray(v["position"]), precision=4),
-                  np.array2string(np.asarray(v["quaternion_xyzw"]), precision=4))
+        f.add_row(
+            k,
+            v["link"],
+            np.array2string(np.asarray(v["position"]), precision=4),
+            np.array2string(np.asarray(v["quaternion_xyzw"]), precision=4),
+        )
     con.print(f)
     if png is not None:
-        note = "" if data["rendered_by"] == backend_name else (
-            f" (backend {backend_name!r} cannot render: snapshot rendered through {data['rendered_by']!r})")
+        note = (
+            ""
+            if data["rendered_by"] == backend_name
+            else (
+                f" (backend {backend_name!r} cannot render: snapshot rendered through {data['rendered_by']!r})"
+            )
+        )
         con.print(f"snapshot: {png}{note}")

@@ -14,8 +14,8 @@ import click
 
 from ..cube import (
     ALGORITHM,
-    MoveError,
     SOLVED_STRING,
+    MoveError,
     UnknownTierError,
     differences,
     expected_final,
@@ -66,7 +66,9 @@ def rubiks() -> None:
     """
 
 
-@rubiks.command("tiers", context_settings=_CTX, short_help="List tiers with M, N and published baselines.")
+@rubiks.command(
+    "tiers", context_settings=_CTX, short_help="List tiers with M, N and published baselines."
+)
 @json_option
 def tiers_cmd(as_json: bool) -> None:
     """List the twelve tiers with M, N and the paper's Table I baselines.
@@ -85,14 +87,25 @@ def tiers_cmd(as_json: bool) -> None:
     for t in tiers.values():
         cells = "".join(f"{b.describe():<26}" for b in t.baselines)
         click.echo(f"{t.name:<14}{t.trials:>3}{t.moves:>5}  {cells}".rstrip())
-    click.echo("Published mean / standard deviation of trial time in seconds (Yang et al., RA-L, Table I);")
-    click.echo("\"—\" std: single trial.")
+    click.echo(
+        "Published mean / standard deviation of trial time in seconds (Yang et al., RA-L, Table I);"
+    )
+    click.echo('"—" std: single trial.')
 
 
-@rubiks.command("sequence", context_settings=_CTX, short_help="Print a tier's fixed-seed move sequences.")
-@click.option("--tier", "tier_name", required=True, metavar="TIER", help="Tier name, e.g. Rubiks-5-20.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Non-negative integer seed; report it with your score.")
+@rubiks.command(
+    "sequence", context_settings=_CTX, short_help="Print a tier's fixed-seed move sequences."
+)
+@click.option(
+    "--tier", "tier_name", required=True, metavar="TIER", help="Tier name, e.g. Rubiks-5-20."
+)
+@click.option(
+    "--seed",
+    type=click.IntRange(min=0),
+    default=0,
+    show_default=True,
+    help="Non-negative integer seed; report it with your score.",
+)
 @json_option
 def sequence_cmd(tier_name: str, seed: int, as_json: bool) -> None:
     """Print the tier's M move sequences, one line of N moves per trial.
@@ -126,10 +139,19 @@ def sequence_cmd(tier_name: str, seed: int, as_json: bool) -> None:
         click.echo(format_sequence(s))
 
 
-@rubiks.command("expect", context_settings=_CTX, short_help="Print the state expected after a sequence.")
-@click.option("--sequence", "sequence", required=True, help='Moves, space separated, e.g. "R U R\' U\'".')
-@click.option("--initial", default=SOLVED_STRING, show_default="solved", metavar="FACELETS",
-              help="Initial state (54 letters).")
+@rubiks.command(
+    "expect", context_settings=_CTX, short_help="Print the state expected after a sequence."
+)
+@click.option(
+    "--sequence", "sequence", required=True, help="Moves, space separated, e.g. \"R U R' U'\"."
+)
+@click.option(
+    "--initial",
+    default=SOLVED_STRING,
+    show_default="solved",
+    metavar="FACELETS",
+    help="Initial state (54 letters).",
+)
 @json_option
 def expect_cmd(sequence: str, initial: str, as_json: bool) -> None:
     """Print the 54-letter state expected after SEQUENCE from the initial state.
@@ -145,16 +167,32 @@ def expect_cmd(sequence: str, initial: str, as_json: bool) -> None:
     init = _initial(initial)
     final = expected_final(moves, init)
     if as_json:
-        emit_json({"initial": init, "sequence": format_sequence(moves), "moves": len(moves), "final": final})
+        emit_json(
+            {
+                "initial": init,
+                "sequence": format_sequence(moves),
+                "moves": len(moves),
+                "final": final,
+            }
+        )
         return
     click.echo(final)
 
 
-@rubiks.command("validate", context_settings=_CTX, short_help="Check an observed final state (exit 0/1/2).")
-@click.option("--initial", default=SOLVED_STRING, show_default="solved", metavar="FACELETS",
-              help="State the cube was in before the sequence.")
+@rubiks.command(
+    "validate", context_settings=_CTX, short_help="Check an observed final state (exit 0/1/2)."
+)
+@click.option(
+    "--initial",
+    default=SOLVED_STRING,
+    show_default="solved",
+    metavar="FACELETS",
+    help="State the cube was in before the sequence.",
+)
 @click.option("--sequence", "sequence", required=True, help="The moves the robot had to perform.")
-@click.option("--final", "final", required=True, metavar="FACELETS", help="The state you observed at the end.")
+@click.option(
+    "--final", "final", required=True, metavar="FACELETS", help="The state you observed at the end."
+)
 @json_option
 def validate_cmd(initial: str, sequence: str, final: str, as_json: bool) -> None:
     """Check an observed final state against the expected one (protocol step 6).
@@ -185,7 +223,9 @@ def validate_cmd(initial: str, sequence: str, final: str, as_json: bool) -> None
                 "match": not diffs,
                 "expected_final": expected,
                 "observed_final": final,
-                "differences": [{"facelet": d.name, "expected": d.expected, "got": d.observed} for d in diffs],
+                "differences": [
+                    {"facelet": d.name, "expected": d.expected, "got": d.observed} for d in diffs
+                ],
                 "observed_problems": illegal,
             }
         )
@@ -203,7 +243,9 @@ def validate_cmd(initial: str, sequence: str, final: str, as_json: bool) -> None
         raise SystemExit(EXIT_NEGATIVE)
 
 
-@rubiks.command("check", context_settings=_CTX, short_help="Say whether a facelet string is a legal cube.")
+@rubiks.command(
+    "check", context_settings=_CTX, short_help="Say whether a facelet string is a legal cube."
+)
 @click.argument("facelets")
 @json_option
 def check_cmd(facelets: str, as_json: bool) -> None:
@@ -225,10 +267,16 @@ def check_cmd(facelets: str, as_json: bool) -> None:
         raise SystemExit(EXIT_NEGATIVE)
 
 
-@rubiks.command("score", context_settings=_CTX, short_help="Score a trial log: tier score and completion.")
+@rubiks.command(
+    "score", context_settings=_CTX, short_help="Score a trial log: tier score and completion."
+)
 @click.argument("log", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--seed", type=click.IntRange(min=0), default=None,
-              help="Also require each sequence to be the generator's for this seed.")
+@click.option(
+    "--seed",
+    type=click.IntRange(min=0),
+    default=None,
+    help="Also require each sequence to be the generator's for this seed.",
+)
 @json_option
 def score_cmd(log: Path, seed: int | None, as_json: bool) -> None:
     """Score a trial log (CSV or JSON): success per trial, tier score, completion.
@@ -268,10 +316,14 @@ def _fmt(mean: float | None, std: float | None) -> str:
 
 def _print_tier_score(s) -> None:
     if s.completed:
-        click.echo(f"{s.tier}: completed, score {_fmt(s.mean_s, s.std_s)} (mean ± sample std, "
-                   f"{s.trials_required} trial{'s' if s.trials_required != 1 else ''})")
+        click.echo(
+            f"{s.tier}: completed, score {_fmt(s.mean_s, s.std_s)} (mean ± sample std, "
+            f"{s.trials_required} trial{'s' if s.trials_required != 1 else ''})"
+        )
     else:
-        click.echo(f"{s.tier}: NOT completed ({s.successes} of {s.trials_required} trials succeeded)")
+        click.echo(
+            f"{s.tier}: NOT completed ({s.successes} of {s.trials_required} trials succeeded)"
+        )
         if s.successes:
             click.echo(f"  successful trials only (not a tier score): {_fmt(s.mean_s, s.std_s)}")
         for p in s.problems:

@@ -9,8 +9,9 @@ strategy, task ..., with the plugin manager's message). See docs/runner.md.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import click
 import numpy as np
@@ -37,7 +38,7 @@ def _fmt(x: float | None, digits: int = 2) -> str:
             return "—"
     except TypeError:
         return str(x)
-    return f"{x:.{digits}f}" if abs(x) >= 10 ** -digits or x == 0 else f"{x:.2g}"
+    return f"{x:.{digits}f}" if abs(x) >= 10**-digits or x == 0 else f"{x:.2g}"
 
 
 def _esc(text: object) -> str:
@@ -53,7 +54,10 @@ def _names(text: str | None) -> tuple[str, ...]:
 
 def store_option(f: Callable) -> Callable:
     return click.option(
-        "--store", "store_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+        "--store",
+        "store_path",
+        type=click.Path(dir_okay=False, path_type=Path),
+        default=None,
         help="Results store (SQLite). Default: $BENCHHARNESS_STORE, else ./benchharness-results.sqlite.",
     )(f)
 
@@ -70,26 +74,76 @@ def _open_store(path: Path | None):
 def run_options(f: Callable) -> Callable:
     """Options shared by ``run`` and ``compare`` (everything but the backend)."""
     opts = [
-        click.option("--task", required=True, help="Rubik's tier (Rubiks-5-20) or in-hand task set (inhand-level1)."),
+        click.option(
+            "--task",
+            required=True,
+            help="Rubik's tier (Rubiks-5-20) or in-hand task set (inhand-level1).",
+        ),
         click.option("--robot", required=True, help="Robot plugin name (benchharness plugins)."),
         click.option("--strategy", required=True, help="Strategy plugin name."),
-        click.option("--seed", type=int, default=0, show_default=True,
-                     help="Run seed: the protocol's sequences and every trial's random streams."),
+        click.option(
+            "--seed",
+            type=int,
+            default=0,
+            show_default=True,
+            help="Run seed: the protocol's sequences and every trial's random streams.",
+        ),
         click.option("--sensors", default="", help="Comma-separated sensor plugin names."),
-        click.option("--workers", type=int, default=None,
-                     help="Worker processes (default: half the cores, at least 1; 0 runs in this process)."),
-        click.option("--trials", "trial_sel", default=None, help="Only these trial indices, e.g. 1,3-5 (default all)."),
-        click.option("--repeats", type=int, default=1, show_default=True, help="In-hand: trials per task row."),
-        click.option("--physics", "physics_kv", multiple=True, metavar="KEY=VALUE",
-                     help="PhysicsConfig setting, repeatable: timestep=1/500, solver_iterations=100, ..."),
-        click.option("--sim-budget", type=float, default=None,
-                     help="Simulated seconds per trial (default Rubik's 120 + 60 per move; in-hand 120)."),
-        click.option("--wall-budget", type=float, default=None,
-                     help="Wall-clock seconds per trial (default none: results then never depend on machine speed)."),
-        click.option("--plugin", "plugins", multiple=True, metavar="MODULE",
-                     help="Also register this importable plugin module (a strategy under development)."),
-        click.option("--retry-failed", is_flag=True, help="Re-run stored failed trials instead of skipping them."),
-        click.option("--progress/--no-progress", default=None, help="Progress bar on stderr (default: when a terminal)."),
+        click.option(
+            "--workers",
+            type=int,
+            default=None,
+            help="Worker processes (default: half the cores, at least 1; 0 runs in this process).",
+        ),
+        click.option(
+            "--trials",
+            "trial_sel",
+            default=None,
+            help="Only these trial indices, e.g. 1,3-5 (default all).",
+        ),
+        click.option(
+            "--repeats",
+            type=int,
+            default=1,
+            show_default=True,
+            help="In-hand: trials per task row.",
+        ),
+        click.option(
+            "--physics",
+            "physics_kv",
+            multiple=True,
+            metavar="KEY=VALUE",
+            help="PhysicsConfig setting, repeatable: timestep=1/500, solver_iterations=100, ...",
+        ),
+        click.option(
+            "--sim-budget",
+            type=float,
+            default=None,
+            help="Simulated seconds per trial (default Rubik's 120 + 60 per move; in-hand 120).",
+        ),
+        click.option(
+            "--wall-budget",
+            type=float,
+            default=None,
+            help="Wall-clock seconds per trial (default none: results then never depend on machine speed).",
+        ),
+        click.option(
+            "--plugin",
+            "plugins",
+            multiple=True,
+            metavar="MODULE",
+            help="Also register this importable plugin module (a strategy under development).",
+        ),
+        click.option(
+            "--retry-failed",
+            is_flag=True,
+            help="Re-run stored failed trials instead of skipping them.",
+        ),
+        click.option(
+            "--progress/--no-progress",
+            default=None,
+            help="Progress bar on stderr (default: when a terminal).",
+        ),
         store_option,
         json_option,
     ]
@@ -98,7 +152,19 @@ def run_options(f: Callable) -> Callable:
     return f
 
 
-def _spec(task, robot, strategy, backend, seed, sensors, repeats, physics_kv, sim_budget, wall_budget, plugins):
+def _spec(
+    task,
+    robot,
+    strategy,
+    backend,
+    seed,
+    sensors,
+    repeats,
+    physics_kv,
+    sim_budget,
+    wall_budget,
+    plugins,
+):
     from ..plugin import PluginNotFoundError
     from ..runner.contract import TimeBudget
     from ..runner.plugins import lookup
@@ -126,8 +192,16 @@ def _spec(task, robot, strategy, backend, seed, sensors, repeats, physics_kv, si
         else:
             sim_budget = 120.0
     return RunSpec(
-        task=plan.name, robot=robot, strategy=strategy, backend=backend, seed=seed, sensors=_names(sensors),
-        physics=physics, budget=TimeBudget(sim_budget, wall_budget), repeats=repeats, plugins=tuple(plugins),
+        task=plan.name,
+        robot=robot,
+        strategy=strategy,
+        backend=backend,
+        seed=seed,
+        sensors=_names(sensors),
+        physics=physics,
+        budget=TimeBudget(sim_budget, wall_budget),
+        repeats=repeats,
+        plugins=tuple(plugins),
     )
 
 
@@ -143,12 +217,25 @@ class _Progress:
     def start(self, report, pending: int) -> None:
         if not self.enabled:
             return
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
 
         self.progress = Progress(
-            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-            TextColumn("failures: {task.fields[failures]}"), TimeElapsedColumn(), TextColumn("ETA"),
-            TimeRemainingColumn(), console=_console(stderr=True), transient=False,
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("failures: {task.fields[failures]}"),
+            TimeElapsedColumn(),
+            TextColumn("ETA"),
+            TimeRemainingColumn(),
+            console=_console(stderr=True),
+            transient=False,
         )
         self.progress.start()
         self.task = self.progress.add_task(self.label, total=pending, failures=0)
@@ -176,26 +263,50 @@ def _sweep(spec, store, workers, trial_sel, retry_failed, progress, video=None):
     show = sys.stderr.isatty() if progress is None else progress
     bar = _Progress(show, f"{spec.task} {spec.strategy}/{spec.robot}/{spec.backend}")
     try:
-        return run_sweep(spec, store, workers=workers, trials=trial_sel, retry_failed=retry_failed, video=video,
-                         on_start=bar.start, on_record=bar.record)
+        return run_sweep(
+            spec,
+            store,
+            workers=workers,
+            trials=trial_sel,
+            retry_failed=retry_failed,
+            video=video,
+            on_start=bar.start,
+            on_record=bar.record,
+        )
     except (PluginNotFoundError, ValueError, TypeError) as exc:
         fail(str(exc))
     except KeyboardInterrupt:
         bar.stop()
         n = store.count(spec.run_key)
-        fail(f"interrupted; {n} trial(s) of run {spec.run_key} are in {store.path}. "
-             "Re-run the same command to resume.", 130)
+        fail(
+            f"interrupted; {n} trial(s) of run {spec.run_key} are in {store.path}. "
+            "Re-run the same command to resume.",
+            130,
+        )
     finally:
         bar.stop()
 
 
 def _trial_json(t) -> dict[str, Any]:
     return {
-        "run_key": t.run_key, "trial": t.trial_index, "task": t.task, "robot": t.robot, "strategy": t.strategy,
-        "sensors": t.sensors, "backend": t.backend, "seed": t.seed, "status": t.status.value, "score": t.score,
-        "failure_cause": t.failure_cause.value if t.failure_cause else None, "message": t.message,
-        "wall_s": t.wall_s, "sim_s": t.sim_s, "first_contact_s": t.first_contact_s,
-        "termination_s": t.termination_s, "code_version": t.code_version, "physics_hash": t.physics_hash,
+        "run_key": t.run_key,
+        "trial": t.trial_index,
+        "task": t.task,
+        "robot": t.robot,
+        "strategy": t.strategy,
+        "sensors": t.sensors,
+        "backend": t.backend,
+        "seed": t.seed,
+        "status": t.status.value,
+        "score": t.score,
+        "failure_cause": t.failure_cause.value if t.failure_cause else None,
+        "message": t.message,
+        "wall_s": t.wall_s,
+        "sim_s": t.sim_s,
+        "first_contact_s": t.first_contact_s,
+        "termination_s": t.termination_s,
+        "code_version": t.code_version,
+        "physics_hash": t.physics_hash,
     }
 
 
@@ -206,14 +317,28 @@ def _trials_table(rows, title: str, show_run: bool = False):
     if show_run:
         for c in ("task", "method", "seed"):
             table.add_column(c, no_wrap=True)
-    for c, j in (("trial", "right"), ("status", "left"), ("score", "right"), ("cause", "left"),
-                 ("sim s", "right"), ("wall s", "right"), ("message", "left")):
+    for c, j in (
+        ("trial", "right"),
+        ("status", "left"),
+        ("score", "right"),
+        ("cause", "left"),
+        ("sim s", "right"),
+        ("wall s", "right"),
+        ("message", "left"),
+    ):
         table.add_column(c, justify=j)
     for t in rows:
         lead = [_esc(t.task), _esc(t.method), str(t.seed)] if show_run else []
-        table.add_row(*lead, str(t.trial_index), t.status.value, _fmt(t.score, 3),
-                      t.failure_cause.value if t.failure_cause else "", _fmt(t.sim_s, 2), _fmt(t.wall_s, 2),
-                      _esc((t.message or "")[:90]))
+        table.add_row(
+            *lead,
+            str(t.trial_index),
+            t.status.value,
+            _fmt(t.score, 3),
+            t.failure_cause.value if t.failure_cause else "",
+            _fmt(t.sim_s, 2),
+            _fmt(t.wall_s, 2),
+            _esc((t.message or "")[:90]),
+        )
     return table
 
 
@@ -233,13 +358,51 @@ def _summary(spec, store, benchmark: str, total: int, selected: Sequence[int]):
 
 @click.command("run", context_settings=_CTX)
 @run_options
-@click.option("--backend", default="pybullet", show_default=True, help="Backend plugin name (pybullet, sapien).")
-@click.option("--video", "video_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Record one trial as MP4 (GIF if the path ends .gif) through Backend.render.")
-@click.option("--video-trial", type=int, default=1, show_default=True, help="Which trial --video records.")
-@click.option("--video-fps", type=float, default=30.0, show_default=True, help="Frames per *simulated* second.")
-def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physics_kv, sim_budget, wall_budget,
-        plugins, retry_failed, progress, store_path, as_json, backend, video_path, video_trial, video_fps) -> None:
+@click.option(
+    "--backend",
+    default="pybullet",
+    show_default=True,
+    help="Backend plugin name (pybullet, sapien).",
+)
+@click.option(
+    "--video",
+    "video_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Record one trial as MP4 (GIF if the path ends .gif) through Backend.render.",
+)
+@click.option(
+    "--video-trial", type=int, default=1, show_default=True, help="Which trial --video records."
+)
+@click.option(
+    "--video-fps",
+    type=float,
+    default=30.0,
+    show_default=True,
+    help="Frames per *simulated* second.",
+)
+def run(
+    task,
+    robot,
+    strategy,
+    seed,
+    sensors,
+    workers,
+    trial_sel,
+    repeats,
+    physics_kv,
+    sim_budget,
+    wall_budget,
+    plugins,
+    retry_failed,
+    progress,
+    store_path,
+    as_json,
+    backend,
+    video_path,
+    video_trial,
+    video_fps,
+) -> None:
     """Run a task's trials with a robot, strategy, sensors and backend; store each as it ends.
 
     Re-running the same command resumes: trials already in the store under the
@@ -252,7 +415,19 @@ def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physi
       benchharness run --task inhand-level1 --robot allegro --strategy relaxed-rigidity --repeats 5
       benchharness run --task Rubiks-1-5 --robot pr2 --strategy dead-reckoning --video trial1.mp4
     """
-    spec = _spec(task, robot, strategy, backend, seed, sensors, repeats, physics_kv, sim_budget, wall_budget, plugins)
+    spec = _spec(
+        task,
+        robot,
+        strategy,
+        backend,
+        seed,
+        sensors,
+        repeats,
+        physics_kv,
+        sim_budget,
+        wall_budget,
+        plugins,
+    )
     video = None
     if video_path is not None:
         from ..runner.plugins import lookup
@@ -264,8 +439,10 @@ def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physi
             fail(str(exc))
         caps = item.meta.get("capabilities") or {}
         if not caps.get("camera", False):
-            fail(f"--video needs a backend that can render images; backend {backend!r} has no camera "
-                 f"(capabilities.camera is false). Use --backend pybullet.")
+            fail(
+                f"--video needs a backend that can render images; backend {backend!r} has no camera "
+                f"(capabilities.camera is false). Use --backend pybullet."
+            )
         try:
             video = VideoSpec(video_path, video_trial, video_fps)
         except ValueError as exc:
@@ -274,34 +451,58 @@ def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physi
         t0 = time.perf_counter()
         report = _sweep(spec, store, workers, trial_sel, retry_failed, progress, video)
         elapsed = time.perf_counter() - t0
-        rows, cell = _summary(spec, store, report.plan.benchmark, report.plan.total, report.selected)
+        rows, cell = _summary(
+            spec, store, report.plan.benchmark, report.plan.total, report.selected
+        )
         video_info = None
         if video is not None:
             rec = next((r for r in report.records if r.trial_index == video.trial_index), None)
             video_info = rec.diagnostics.get("video") if rec is not None else None
         failed = any(r.status.value == "failure" for r in rows)
         if as_json:
-            emit_json({
-                "run": spec.to_json(), "store": str(store.path), "benchmark": report.plan.benchmark,
-                "trials_total": report.plan.total, "selected": report.selected, "ran": report.ran,
-                "skipped": report.skipped, "failures": sum(r.status.value == "failure" for r in rows),
-                "elapsed_s": elapsed, "tier": None if cell is None else cell.to_dict(),
-                "video": video_info, "trials": [_trial_json(t) for t in rows],
-            })
+            emit_json(
+                {
+                    "run": spec.to_json(),
+                    "store": str(store.path),
+                    "benchmark": report.plan.benchmark,
+                    "trials_total": report.plan.total,
+                    "selected": report.selected,
+                    "ran": report.ran,
+                    "skipped": report.skipped,
+                    "failures": sum(r.status.value == "failure" for r in rows),
+                    "elapsed_s": elapsed,
+                    "tier": None if cell is None else cell.to_dict(),
+                    "video": video_info,
+                    "trials": [_trial_json(t) for t in rows],
+                }
+            )
         else:
             console = _console()
-            console.print(_trials_table(rows, _esc(f"{spec.task}: {spec.strategy} on {spec.robot}, {spec.backend}, seed {spec.seed}")))
-            console.print(f"run {spec.run_key} in {store.path}: ran {report.ran}, skipped {len(report.skipped)} "
-                          f"already stored, {elapsed:.1f} s")
+            console.print(
+                _trials_table(
+                    rows,
+                    _esc(
+                        f"{spec.task}: {spec.strategy} on {spec.robot}, {spec.backend}, seed {spec.seed}"
+                    ),
+                )
+            )
+            console.print(
+                f"run {spec.run_key} in {store.path}: ran {report.ran}, skipped {len(report.skipped)} "
+                f"already stored, {elapsed:.1f} s"
+            )
             if cell is not None:
                 from ..runner.reports import format_cell
 
                 state = "completed" if cell.completed else "not completed"
-                console.print(f"{spec.task}: {state} — {format_cell(cell)} s "
-                              f"({cell.successes}/{cell.trials_required} trials in the expected state)")
+                console.print(
+                    f"{spec.task}: {state} — {format_cell(cell)} s "
+                    f"({cell.successes}/{cell.trials_required} trials in the expected state)"
+                )
             if video_info:
-                console.print(f"video: {video_info['path']} ({video_info['frames']} frames at {video_info['fps']:g} fps)"
-                              + (f" — {video_info['note']}" if video_info.get("note") else ""))
+                console.print(
+                    f"video: {video_info['path']} ({video_info['frames']} frames at {video_info['fps']:g} fps)"
+                    + (f" — {video_info['note']}" if video_info.get("note") else "")
+                )
         if failed:
             raise SystemExit(EXIT_NEGATIVE)
 
@@ -311,17 +512,32 @@ def run(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physi
 
 @click.command("table", context_settings=_CTX)
 @store_option
-@click.option("--benchmark", type=click.Choice(["rubiks", "inhand"]), default=None,
-              help="Which paper's tables (default: each benchmark present in the store).")
+@click.option(
+    "--benchmark",
+    type=click.Choice(["rubiks", "inhand"]),
+    default=None,
+    help="Which paper's tables (default: each benchmark present in the store).",
+)
 @click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
 @click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
 @click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
 @click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
-@click.option("--run-tiers", is_flag=True, help="Rubik's: only tiers with results (default all twelve, as in the paper).")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="In-hand: also write the Figure-7 box plot (per object, one box per method) to this .png/.svg.")
+@click.option(
+    "--run-tiers",
+    is_flag=True,
+    help="Rubik's: only tiers with results (default all twelve, as in the paper).",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="In-hand: also write the Figure-7 box plot (per object, one box per method) to this .png/.svg.",
+)
 @json_option
-def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers, plot_path, as_json) -> None:
+def table(
+    store_path, benchmark, strategies, backends, robots, seeds, run_tiers, plot_path, as_json
+) -> None:
     """Our results in the papers' layouts, with the published figures beside them.
 
     \b
@@ -337,17 +553,31 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
       benchharness table --benchmark rubiks --run-tiers
       benchharness table --benchmark inhand --plot figure7.png
     """
-    from ..runner.reports import format_cell, inhand_box_plot, inhand_table2, inhand_table3, rubiks_table
+    from ..runner.reports import (
+        format_cell,
+        inhand_box_plot,
+        inhand_table2,
+        inhand_table3,
+        rubiks_table,
+    )
 
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         fail(f"--plot: {plot_path} must end in .png or .svg")
 
     with _open_store(store_path) as store:
-        filters = dict(strategy=list(strategies) or None, backend=list(backends) or None,
-                       robot=list(robots) or None, seed=list(seeds) or None)
+        filters = dict(
+            strategy=list(strategies) or None,
+            backend=list(backends) or None,
+            robot=list(robots) or None,
+            seed=list(seeds) or None,
+        )
         trials = store.trials(benchmark=benchmark, **filters)
     present = {t.benchmark for t in trials}
-    wanted = [benchmark] if benchmark else [b for b in ("rubiks", "inhand") if b in present] or ["rubiks"]
+    wanted = (
+        [benchmark]
+        if benchmark
+        else [b for b in ("rubiks", "inhand") if b in present] or ["rubiks"]
+    )
     out: dict[str, Any] = {}
     console = None if as_json else _console()
     if "rubiks" in wanted:
@@ -357,18 +587,25 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
         else:
             from rich.table import Table
 
-            t = Table(title="Rubik's cube benchmark (Table I layout): mean / std of trial time, s; — not completed")
+            t = Table(
+                title="Rubik's cube benchmark (Table I layout): mean / std of trial time, s; — not completed"
+            )
             t.add_column("Tier", no_wrap=True)
             for _, label in tab.published:
                 t.add_column(f"{label} (paper)", justify="right")
             for c in tab.columns:
                 t.add_column(_esc(c.label), justify="right")
             for tier in tab.tiers:
-                t.add_row(tier, *[tab.published_cell(tier, k) for k, _ in tab.published],
-                          *[format_cell(tab.cells.get((tier, c.label))) for c in tab.columns])
+                t.add_row(
+                    tier,
+                    *[tab.published_cell(tier, k) for k, _ in tab.published],
+                    *[format_cell(tab.cells.get((tier, c.label))) for c in tab.columns],
+                )
             console.print(t)
             if not tab.columns:
-                console.print("No Rubik's results in the store yet (benchharness run --task Rubiks-...).")
+                console.print(
+                    "No Rubik's results in the store yet (benchharness run --task Rubiks-...)."
+                )
             for c in tab.columns:
                 if "," in c.code_version:
                     console.print(f"{_esc(c.label)}: runs from code versions {c.code_version}")
@@ -382,14 +619,28 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
             from ..runner.published import TABLE_III_ROWS
 
             t = Table(title="In-hand benchmark (Table II layout): medians over trials")
-            for c, j in (("method", "left"), ("source", "left"), ("n", "right"), ("drops %", "right"),
-                         ("err_pos (cm)", "right"), ("err_pos%", "right"), ("err_or%", "right"),
-                         ("other failures", "right")):
+            for c, j in (
+                ("method", "left"),
+                ("source", "left"),
+                ("n", "right"),
+                ("drops %", "right"),
+                ("err_pos (cm)", "right"),
+                ("err_pos%", "right"),
+                ("err_or%", "right"),
+                ("other failures", "right"),
+            ):
                 t.add_column(c, justify=j)
             for r in t2:
-                t.add_row(_esc(r["method"]), r["source"], str(r.get("trials", "")), _fmt(r.get("drops_percent"), 1),
-                          _fmt(r.get("err_pos_cm")), _fmt(r.get("err_pos_percent")), _fmt(r.get("err_or_percent")),
-                          str(r.get("failed_other", "")))
+                t.add_row(
+                    _esc(r["method"]),
+                    r["source"],
+                    str(r.get("trials", "")),
+                    _fmt(r.get("drops_percent"), 1),
+                    _fmt(r.get("err_pos_cm")),
+                    _fmt(r.get("err_pos_percent")),
+                    _fmt(r.get("err_or_percent")),
+                    str(r.get("failed_other", "")),
+                )
             console.print(t)
             methods: dict[str, list] = {}
             for r in t3:
@@ -404,7 +655,9 @@ def table(store_path, benchmark, strategies, backends, robots, seeds, run_tiers,
                     for r in rows:
                         paper = r["paper"].get(key)
                         ours = r["ours"].get(key)
-                        cells.append(f"{_fmt(ours, 3)} | {_fmt(paper, 3) if paper is not None else ''}")
+                        cells.append(
+                            f"{_fmt(ours, 3)} | {_fmt(paper, 3) if paper is not None else ''}"
+                        )
                     t.add_row(label, *cells)
                 t.add_row("drops %", *[_fmt(r["drops_percent"], 1) for r in rows])
                 console.print(t)
@@ -444,8 +697,10 @@ def _contact_scorer():
         if trial.task not in desired:
             try:
                 ts = get_manager().create("task", trial.task)
-                desired[trial.task] = {str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)}
-            except Exception:  # not an in-hand task set with contacts
+                desired[trial.task] = {
+                    str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)
+                }
+            except Exception:  # noqa: BLE001 - not an in-hand task set with contacts
                 desired[trial.task] = {}
         want = desired[trial.task].get(o.get("task_id"))
         if want is None or not np.all(np.isfinite(np.asarray(want, float))):
@@ -460,9 +715,31 @@ def _contact_scorer():
 
 @click.command("compare", context_settings=_CTX)
 @run_options
-@click.option("--backends", default="pybullet,sapien", show_default=True, help="Comma-separated backends to compare.")
-def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, physics_kv, sim_budget, wall_budget,
-            plugins, retry_failed, progress, store_path, as_json, backends) -> None:
+@click.option(
+    "--backends",
+    default="pybullet,sapien",
+    show_default=True,
+    help="Comma-separated backends to compare.",
+)
+def compare(
+    task,
+    robot,
+    strategy,
+    seed,
+    sensors,
+    workers,
+    trial_sel,
+    repeats,
+    physics_kv,
+    sim_budget,
+    wall_budget,
+    plugins,
+    retry_failed,
+    progress,
+    store_path,
+    as_json,
+    backends,
+) -> None:
     """Run the same trials on several backends and show them side by side.
 
     Each backend's run is an ordinary stored run (so it resumes, and shows up
@@ -484,12 +761,26 @@ def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, p
         benchmark = None
         required = None
         for b in names:
-            spec = _spec(task, robot, strategy, b, seed, sensors, repeats, physics_kv, sim_budget, wall_budget, plugins)
+            spec = _spec(
+                task,
+                robot,
+                strategy,
+                b,
+                seed,
+                sensors,
+                repeats,
+                physics_kv,
+                sim_budget,
+                wall_budget,
+                plugins,
+            )
             report = _sweep(spec, store, workers, trial_sel, retry_failed, progress)
             benchmark = report.plan.benchmark
             required = report.plan.total if trial_sel is None else None
             sel = set(report.selected)
-            runs.append((b, [t for t in store.trials(run_key=spec.run_key) if t.trial_index in sel]))
+            runs.append(
+                (b, [t for t in store.trials(run_key=spec.run_key) if t.trial_index in sel])
+            )
     data = compare_backends(runs, required)
     if as_json:
         emit_json({"task": task, "benchmark": benchmark, "backends": list(names), **data})
@@ -514,14 +805,29 @@ def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, p
         t.add_row(*cells)
     console.print(t)
     s = Table(title="summary")
-    for c in ("backend", "trials", "successes", "completed", "mean / std s", "failure causes", "real-time factor"):
+    for c in (
+        "backend",
+        "trials",
+        "successes",
+        "completed",
+        "mean / std s",
+        "failure causes",
+        "real-time factor",
+    ):
         s.add_column(c)
     for b in names:
         v = data["summary"][b]
         causes = ", ".join(f"{k}×{n}" for k, n in v["causes"].items())
         ms = "" if v["mean_s"] is None else f"{v['mean_s']:.2f} / {_fmt(v['std_s'])}"
-        s.add_row(b, str(v["trials"]), str(v["successes"]), "" if v["completed"] is None else str(v["completed"]).lower(),
-                  ms, causes, _fmt(v["real_time_factor"], 2))
+        s.add_row(
+            b,
+            str(v["trials"]),
+            str(v["successes"]),
+            "" if v["completed"] is None else str(v["completed"]).lower(),
+            ms,
+            causes,
+            _fmt(v["real_time_factor"], 2),
+        )
     console.print(s)
     if benchmark == "inhand":
         h = Table(title="in-hand, per backend (Table II layout): medians over scored trials")
@@ -529,8 +835,15 @@ def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, p
             h.add_column(c, justify="left" if c == "backend" else "right")
         for b in names:
             v = data["summary"][b]["inhand"] or {}
-            h.add_row(b, str(v.get("trials", 0)), str(v.get("discarded", 0)), _fmt(v.get("drops_percent"), 1),
-                      _fmt(v.get("err_pos_cm")), _fmt(v.get("err_pos_percent")), _fmt(v.get("err_or_percent")))
+            h.add_row(
+                b,
+                str(v.get("trials", 0)),
+                str(v.get("discarded", 0)),
+                _fmt(v.get("drops_percent"), 1),
+                _fmt(v.get("err_pos_cm")),
+                _fmt(v.get("err_pos_percent")),
+                _fmt(v.get("err_or_percent")),
+            )
         console.print(h)
 
 
@@ -547,11 +860,27 @@ def compare(task, robot, strategy, seed, sensors, workers, trial_sel, repeats, p
 @click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
 @click.option("--run", "run_prefix", default=None, help="Only the run whose key starts with this.")
 @click.option("--traceback", "show_tb", is_flag=True, help="Print each failed trial's traceback.")
-@click.option("--plot-pose-error", "plot_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Write a PNG of cube pose-estimate error against move index, per method.")
+@click.option(
+    "--plot-pose-error",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Write a PNG of cube pose-estimate error against move index, per method.",
+)
 @json_option
-def results(store_path, failures, tasks, strategies, backends, robots, seeds, run_prefix, show_tb, plot_path,
-            as_json) -> None:
+def results(
+    store_path,
+    failures,
+    tasks,
+    strategies,
+    backends,
+    robots,
+    seeds,
+    run_prefix,
+    show_tb,
+    plot_path,
+    as_json,
+) -> None:
     """List stored trials with status, score and failure cause.
 
     \b
@@ -561,8 +890,12 @@ def results(store_path, failures, tasks, strategies, backends, robots, seeds, ru
     """
     with _open_store(store_path) as store:
         rows = store.trials(
-            failures_only=failures, task=list(tasks) or None, strategy=list(strategies) or None,
-            backend=list(backends) or None, robot=list(robots) or None, seed=list(seeds) or None,
+            failures_only=failures,
+            task=list(tasks) or None,
+            strategy=list(strategies) or None,
+            backend=list(backends) or None,
+            robot=list(robots) or None,
+            seed=list(seeds) or None,
         )
     if run_prefix:
         rows = [t for t in rows if t.run_key.startswith(run_prefix)]
@@ -585,7 +918,9 @@ def results(store_path, failures, tasks, strategies, backends, robots, seeds, ru
         emit_json({"trials": data, "plot": plotted})
         return
     console = _console()
-    console.print(_trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True))
+    console.print(
+        _trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True)
+    )
     if show_tb:
         for t in rows:
             if t.traceback:

@@ -35,9 +35,9 @@ U-coloured centre up, the F-coloured centre in front) — see its docstring.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Iterable, Sequence
 
 import numpy as np
 
@@ -50,7 +50,15 @@ FACE_KINDS = "URFDLB"
 # Which face each kind turns like, and which layer (cubie · normal) it moves;
 # ``None`` means every layer (a whole-cube rotation).
 _TURNS_LIKE = {"M": "L", "E": "D", "S": "F", "x": "R", "y": "U", "z": "F"}
-_LAYER: dict[str, int | None] = {**{f: 1 for f in FACE_KINDS}, "M": 0, "E": 0, "S": 0, "x": None, "y": None, "z": None}
+_LAYER: dict[str, int | None] = {
+    **{f: 1 for f in FACE_KINDS},
+    "M": 0,
+    "E": 0,
+    "S": 0,
+    "x": None,
+    "y": None,
+    "z": None,
+}
 
 _SUFFIX = {1: "", 2: "2", 3: "'"}
 _KIND_POSITION = {k: i for i, k in enumerate(KINDS)}
@@ -63,7 +71,9 @@ class MoveError(ValueError):
     def __init__(self, token: str, position: int) -> None:
         self.token = token
         self.position = position
-        super().__init__(f'unknown move "{token}" at position {position} (expected {EXPECTED_TOKENS})')
+        super().__init__(
+            f'unknown move "{token}" at position {position} (expected {EXPECTED_TOKENS})'
+        )
 
 
 @dataclass(frozen=True, order=True)
@@ -82,7 +92,7 @@ class Move:
         """Row of :data:`MOVE_PERMUTATIONS` (kind-major, then 1, 2, 3 turns)."""
         return 3 * _KIND_POSITION[self.kind] + self.turns - 1
 
-    def inverse(self) -> "Move":
+    def inverse(self) -> Move:
         return Move(self.kind, 4 - self.turns)
 
     def __str__(self) -> str:

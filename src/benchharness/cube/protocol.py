@@ -10,8 +10,8 @@ same cube.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 from .facelets import FACELET_NAMES, SOLVED_STRING, to_string
 from .moves import Move, apply, reorient
@@ -44,5 +44,7 @@ def differences(expected: str, observed: str) -> list[FaceletDifference]:
     if len(expected) != 54 or len(observed) != 54:
         raise ValueError("both states must have 54 facelets")
     return [
-        FaceletDifference(FACELET_NAMES[i], e, o) for i, (e, o) in enumerate(zip(expected, observed)) if e != o
+        FaceletDifference(FACELET_NAMES[i], e, o)
+        for i, (e, o) in enumerate(zip(expected, observed))
+        if e != o
     ]

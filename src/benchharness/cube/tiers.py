@@ -7,10 +7,11 @@ install reads the same file (through :func:`benchharness.paths.tasks_dir`).
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+
+import tomllib
 
 from ..paths import tasks_dir
 from .moves import Move
@@ -57,7 +58,12 @@ class RubiksTier:
             "trials": self.trials,
             "moves": self.moves,
             "baselines": {
-                b.key: {"label": b.label, "completed": b.completed, "mean_s": b.mean_s, "std_s": b.std_s}
+                b.key: {
+                    "label": b.label,
+                    "completed": b.completed,
+                    "mean_s": b.mean_s,
+                    "std_s": b.std_s,
+                }
                 for b in self.baselines
             },
         }
@@ -76,10 +82,14 @@ def _parse(data: dict) -> dict[str, RubiksTier]:
             b = row.get(key)
             if b is None:
                 continue
-            baselines.append(BaselineScore(key, label, bool(b["completed"]), b.get("mean_s"), b.get("std_s")))
+            baselines.append(
+                BaselineScore(key, label, bool(b["completed"]), b.get("mean_s"), b.get("std_s"))
+            )
         tier = RubiksTier(row["name"], int(row["trials"]), int(row["moves"]), tuple(baselines))
         if tier.name != f"Rubiks-{tier.trials}-{tier.moves}":
-            raise ValueError(f"tier {tier.name!r} does not match its trials/moves ({tier.trials}, {tier.moves})")
+            raise ValueError(
+                f"tier {tier.name!r} does not match its trials/moves ({tier.trials}, {tier.moves})"
+            )
         out[tier.name] = tier
     return out
 

@@ -87,7 +87,9 @@ def _form_reasons(s: str) -> list[str]:
     if bad:
         shown = ", ".join(f"{ch!r} at {FACELET_NAMES[i]}" for i, ch in bad[:5])
         more = f" and {len(bad) - 5} more" if len(bad) > 5 else ""
-        return [f"invalid character{'s' if len(bad) > 1 else ''} {shown}{more}; facelets must be letters from URFDLB"]
+        return [
+            f"invalid character{'s' if len(bad) > 1 else ''} {shown}{more}; facelets must be letters from URFDLB"
+        ]
     return []
 
 
@@ -127,7 +129,9 @@ def _cubie_reasons(s: str) -> list[str]:
             )
             continue
         if cubie in where_c:
-            reasons.append(f"corner cubie {_CORNER_NAMES[cubie]} appears twice, at {where_c[cubie]} and {pos}")
+            reasons.append(
+                f"corner cubie {_CORNER_NAMES[cubie]} appears twice, at {where_c[cubie]} and {pos}"
+            )
             continue
         where_c[cubie] = pos
         c_perm.append(cubie)
@@ -139,10 +143,14 @@ def _cubie_reasons(s: str) -> list[str]:
         elif cols[::-1] in edge_colours:
             cubie, flip = edge_colours.index(cols[::-1]), 1
         else:
-            reasons.append(f"edge {pos} ({'/'.join(EDGES[pos])}) shows {'-'.join(cols)}, which is no edge of the cube")
+            reasons.append(
+                f"edge {pos} ({'/'.join(EDGES[pos])}) shows {'-'.join(cols)}, which is no edge of the cube"
+            )
             continue
         if cubie in where_e:
-            reasons.append(f"edge cubie {_EDGE_NAMES[cubie]} appears twice, at {where_e[cubie]} and {pos}")
+            reasons.append(
+                f"edge cubie {_EDGE_NAMES[cubie]} appears twice, at {where_e[cubie]} and {pos}"
+            )
             continue
         where_e[cubie] = pos
         e_perm.append(cubie)
@@ -157,7 +165,9 @@ def _cubie_reasons(s: str) -> list[str]:
         )
     flip = sum(e_flip) % 2
     if flip:
-        reasons.append("edge flip: the edge orientations sum to 1 mod 2, must be 0 (an edge is flipped in place)")
+        reasons.append(
+            "edge flip: the edge orientations sum to 1 mod 2, must be 0 (an edge is flipped in place)"
+        )
     pc, pe = _parity(c_perm), _parity(e_perm)
     if pc != pe:
         word = {0: "even", 1: "odd"}

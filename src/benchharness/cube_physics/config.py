@@ -77,7 +77,9 @@ class CubeConfig:
         if not 0.0 <= self.drag_bias < 1.0:
             raise ValueError(f"CubeConfig.drag_bias must be in [0, 1), got {self.drag_bias!r}")
         if self.snap_tolerance_deg >= 45.0:
-            raise ValueError("CubeConfig.snap_tolerance_deg must be below 45° or snapping is ambiguous")
+            raise ValueError(
+                "CubeConfig.snap_tolerance_deg must be below 45° or snapping is ambiguous"
+            )
 
     @property
     def slab_thickness(self) -> float:

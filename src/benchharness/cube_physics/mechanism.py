@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -80,7 +80,11 @@ class PhysicalCube:
         if state is None:
             self._state = SOLVED.copy()
         else:
-            arr = to_array(state) if isinstance(state, str) else np.asarray(state, dtype=np.uint8).copy()
+            arr = (
+                to_array(state)
+                if isinstance(state, str)
+                else np.asarray(state, dtype=np.uint8).copy()
+            )
             if arr.shape != (54,):
                 raise ValueError(f"a cube state has 54 facelets, got shape {arr.shape}")
             self._state = arr
@@ -140,7 +144,10 @@ class PhysicalCube:
         """The face whose outward normal is closest to the world ``direction``."""
         d = np.asarray(direction, dtype=float)
         rot = self.pose().rotation
-        return max(FACE_BODY_AXES, key=lambda f: float(np.dot(rot.apply(FACE_BODY_AXES[f].astype(float)), d)))
+        return max(
+            FACE_BODY_AXES,
+            key=lambda f: float(np.dot(rot.apply(FACE_BODY_AXES[f].astype(float)), d)),
+        )
 
     def facelet_world_positions(self) -> np.ndarray:
         """World centre of each of the 54 facelets (index = state position), shape (54, 3).
@@ -153,7 +160,12 @@ class PhysicalCube:
         a = axis_index(self._axis)
         out = np.empty_like(local)
         along = local[:, a]
-        slab_of = np.where(np.abs(along) > 0.75 * self.config.slab_thickness, np.sign(along), 0).astype(int) + 1
+        slab_of = (
+            np.where(np.abs(along) > 0.75 * self.config.slab_thickness, np.sign(along), 0).astype(
+                int
+            )
+            + 1
+        )
         for slab in slab_geometry(self.config, self._axis):
             sel = slab_of == slab.index
             link_pose = self.backend.get_link_pose(self._body, slab.link)
@@ -330,7 +342,11 @@ class PhysicalCube:
         pose = b.get_pose(self._body)
         lin, ang = b.get_velocity(self._body)
         snapped = pose * Pose(np.zeros(3), Rotation.from_rotvec(phi * unit).as_quat())
-        b.set_joint_positions(self._body, [math.radians(s0.snapped_deg), math.radians(s2.snapped_deg)], list(JOINT_NAMES))
+        b.set_joint_positions(
+            self._body,
+            [math.radians(s0.snapped_deg), math.radians(s2.snapped_deg)],
+            list(JOINT_NAMES),
+        )
         b.set_pose(self._body, snapped)
         b.remove_body(self._body)
         self._body = self._spawn_rigid(snapped, lin, ang)
@@ -354,7 +370,11 @@ class PhysicalCube:
         unintended = jammed = as_intended = None
         if intent is not None:
             turn = layer[intent.turning] - layer[intent.reference]
-            turned = abs(turn) if abs(intent.angle_deg) == 180.0 else math.copysign(1.0, intent.angle_deg) * turn
+            turned = (
+                abs(turn)
+                if abs(intent.angle_deg) == 180.0
+                else math.copysign(1.0, intent.angle_deg) * turn
+            )
             if intent.turning == 1:  # a slice: the two outer layers must stay together
                 dragged = a2 - a0
             else:  # a face: the middle must stay with the held outer layer

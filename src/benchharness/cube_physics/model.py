@@ -135,7 +135,16 @@ def slab_geometry(config: CubeConfig, axis: str) -> tuple[SlabGeometry, SlabGeom
     for i in range(3):
         centre = np.zeros(3)
         centre[a] = (i - 1) * t
-        out.append(SlabGeometry(SLAB_LINKS[i], i, centre, size.copy(), config.slab_mass, box_inertia(config.slab_mass, size)))
+        out.append(
+            SlabGeometry(
+                SLAB_LINKS[i],
+                i,
+                centre,
+                size.copy(),
+                config.slab_mass,
+                box_inertia(config.slab_mass, size),
+            )
+        )
     return tuple(out)  # type: ignore[return-value]
 
 
@@ -159,7 +168,7 @@ def articulated_urdf(config: CubeConfig, axis: str) -> str:
     slabs = slab_geometry(config, axis)
     axis_vec = np.zeros(3)
     axis_vec[a] = 1.0
-    lines = [f'<?xml version="1.0"?>', f'<robot name="rubiks_cube_axis_{axis}">']
+    lines = ['<?xml version="1.0"?>', f'<robot name="rubiks_cube_axis_{axis}">']
     for s in (slabs[1], slabs[0], slabs[2]):
         ixx, iyy, izz = s.inertia
         lines += [
@@ -191,7 +200,9 @@ def articulated_urdf(config: CubeConfig, axis: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_articulated_urdf(config: CubeConfig, axis: str, directory: str | Path | None = None) -> Path:
+def write_articulated_urdf(
+    config: CubeConfig, axis: str, directory: str | Path | None = None
+) -> Path:
     """Write :func:`articulated_urdf` to a new file (the caller deletes it)."""
     fd, name = tempfile.mkstemp(suffix=".urdf", prefix=f"bh_cube_{axis}_", dir=directory)
     with os.fdopen(fd, "w", encoding="utf-8") as fh:

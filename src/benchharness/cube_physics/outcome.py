@@ -18,7 +18,9 @@ class TwistBlockedError(RuntimeError):
     (a real cube jams the same way), False when a twist is merely still open.
     """
 
-    def __init__(self, axis: str, blocking_axis: str, layer_angles_deg: tuple[float, float], misaligned: bool) -> None:
+    def __init__(
+        self, axis: str, blocking_axis: str, layer_angles_deg: tuple[float, float], misaligned: bool
+    ) -> None:
         self.axis = axis
         self.blocking_axis = blocking_axis
         self.layer_angles_deg = layer_angles_deg
@@ -61,7 +63,9 @@ class TwistOutcome:
     dragged_deg: float | None
     unintended_rotation: bool | None  #: a layer meant to stay still moved beyond the tolerance
     jammed: bool | None  #: the intended layer turned less than the jam threshold
-    as_intended: bool | None  #: logical result equals the core's result of ``intended`` (up to a whole-cube rotation)
+    as_intended: (
+        bool | None
+    )  #: logical result equals the core's result of ``intended`` (up to a whole-cube rotation)
     state_before: np.ndarray
     state_after: np.ndarray
 

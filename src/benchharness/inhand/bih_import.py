@@ -124,8 +124,10 @@ def _dmg_rows(source: Path):
     out = []
     for i, r in enumerate(_sheet(path, "Object", 11)):
         w = f"{path} row {i + 2}"
-        c = {k: _numbers(r[j], 3, f"{w} col {j + 1}") for k, j in
-             (("i1", 2), ("i2", 3), ("d1", 5), ("d2", 6), ("r1", 8), ("r2", 9))}
+        c = {
+            k: _numbers(r[j], 3, f"{w} col {j + 1}")
+            for k, j in (("i1", 2), ("i2", 3), ("d1", 5), ("d2", 6), ("r1", 8), ("r2", 9))
+        }
         q = {k: _numbers(r[j], 4, f"{w} col {j + 1}") for k, j in (("i", 4), ("d", 7), ("r", 10))}
         task = str(int(float(r[1])))
         out.append(dict(object=r[0].strip(), task=task, source_row=i + 2, contacts=c, quats=q))
@@ -163,8 +165,9 @@ def _hand_pose_tasks(source: Path, dmg) -> TaskSet:
             dmg_id = f"{slug(obj)}-dmg{d['task']}"
             note = _DMG_ROWS_NOTE.format(task=d["task"], dmg_id=dmg_id)
             if not np.allclose(ip[:3], mid_i, atol=1e-6):
-                note += "; initial position differs from DMG.ods fingertip midpoint " + \
-                    ",".join(format(float(x), ".6g") for x in mid_i)
+                note += "; initial position differs from DMG.ods fingertip midpoint " + ",".join(
+                    format(float(x), ".6g") for x in mid_i
+                )
         ids.append(tid)
         objs.append(obj)
         levels.append(3 if is_dmg else 1)
@@ -216,7 +219,9 @@ def _dmg_results(dmg) -> ResultSet:
     tasks = _dmg_tasks(dmg)
     contacts = dict(tasks.contacts)
     contacts["reached"] = np.array([[d["contacts"]["r1"], d["contacts"]["r2"]] for d in dmg])
-    reached = np.array([_midpoint_pose(d["contacts"]["r1"], d["contacts"]["r2"], d["quats"]["r"]) for d in dmg])
+    reached = np.array(
+        [_midpoint_pose(d["contacts"]["r1"], d["contacts"]["r2"], d["quats"]["r"]) for d in dmg]
+    )
     blank = ResultSet.empty_like_columns(n)
     return ResultSet(
         method=np.full(n, "DMG", dtype=object),
@@ -240,10 +245,18 @@ def _allegro_results(source: Path, hand_tasks: TaskSet) -> ResultSet:
     path = source / ALLEGRO
     body = _sheet(path, "Object", 7)
     hp_rows = _sheet(source / HAND_POSES, "Object", 3)
-    lookup = {(r[0].strip(), r[1].strip(), r[2].strip()): hand_tasks.task_id[i] for i, r in enumerate(hp_rows)}
+    lookup = {
+        (r[0].strip(), r[1].strip(), r[2].strip()): hand_tasks.task_id[i]
+        for i, r in enumerate(hp_rows)
+    }
     n = len(body)
     ini, des, rea, ids = [], [], [], []
-    extra: dict[str, list[str]] = {"robot": [], "ar_tag_offset_x": [], "ar_tag_offset_y": [], "ar_tag_offset_z": []}
+    extra: dict[str, list[str]] = {
+        "robot": [],
+        "ar_tag_offset_x": [],
+        "ar_tag_offset_y": [],
+        "ar_tag_offset_z": [],
+    }
     extra.update({f"grasp_{j}": [] for j in ALLEGRO_JOINTS})
     extra.update({"fingers": [], "source_row": []})
     for i, r in enumerate(body):

@@ -20,8 +20,9 @@ import io
 import json
 import math
 import re
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -46,7 +47,16 @@ _LEVELS = {"1": 1, "2": 2, "3": 3, "i": 1, "ii": 2, "iii": 3}
 _TRUE = {"1", "true", "yes", "y", "t"}
 _FALSE = {"0", "false", "no", "n", "f", ""}
 
-RESULT_KEYS = ("method", "object", "task_id", "trial", "level", "dropped", "plan_time_s", "exec_time_s")
+RESULT_KEYS = (
+    "method",
+    "object",
+    "task_id",
+    "trial",
+    "level",
+    "dropped",
+    "plan_time_s",
+    "exec_time_s",
+)
 TASK_KEYS = ("task_id", "object", "level")
 PATH_KEYS = ("desired_region", "object_mesh")
 _NCELLS = "\0ncells"
@@ -55,7 +65,13 @@ _NCELLS = "\0ncells"
 class FileFormatError(ValueError):
     """A task/results file that does not follow the format."""
 
-    def __init__(self, path: Path | str | None, message: str, row: int | None = None, column: str | None = None):
+    def __init__(
+        self,
+        path: Path | str | None,
+        message: str,
+        row: int | None = None,
+        column: str | None = None,
+    ):
         self.path, self.row, self.column = path, row, column
         where = str(path) if path is not None else "<data>"
         if row is not None:
@@ -141,7 +157,9 @@ class _RowParser:
         present = np.isfinite(vals)
         if present.any() and not present.all():
             missing = [c for c, ok in zip(cols, present) if not ok]
-            raise self.err(missing[0], f"pose {stage!r} is incomplete (empty: {', '.join(missing)})")
+            raise self.err(
+                missing[0], f"pose {stage!r} is incomplete (empty: {', '.join(missing)})"
+            )
         if present.all() and np.linalg.norm(vals[3:]) < 1e-9:
             raise self.err(cols[3], f"pose {stage!r} has a zero quaternion")
         return vals
@@ -188,7 +206,11 @@ def _known(columns: Iterable[str], is_results: bool) -> set[str]:
 
 def _parse(path: Path | None, columns: Sequence[str], rows: Sequence[Mapping[str, Any]], kind: str):
     is_results = kind == "results"
-    required = list(RESULT_KEYS if is_results else TASK_KEYS) + pose_columns("initial") + pose_columns("desired")
+    required = (
+        list(RESULT_KEYS if is_results else TASK_KEYS)
+        + pose_columns("initial")
+        + pose_columns("desired")
+    )
     if is_results:
         required += pose_columns("reached")
     _check_header(path, columns, required)
@@ -197,7 +219,19 @@ def _parse(path: Path | None, columns: Sequence[str], rows: Sequence[Mapping[str
     layout = _contact_layout(columns)
     extra_cols = [c for c in columns if c not in _known(columns, is_results)]
     n = len(rows)
-    out: dict[str, Any] = {k: [] for k in ("method", "object", "task_id", "trial", "level", "dropped", "plan_time_s", "exec_time_s")}
+    out: dict[str, Any] = {
+        k: []
+        for k in (
+            "method",
+            "object",
+            "task_id",
+            "trial",
+            "level",
+            "dropped",
+            "plan_time_s",
+            "exec_time_s",
+        )
+    }
     poses = {s: np.full((n, 7), np.nan) for s in POSE_STAGES}
     contacts = {s: np.full((n, k, 3), np.nan) for s, k in layout.items()}
     paths = {k: [] for k in PATH_KEYS}
@@ -266,7 +300,7 @@ def _read_csv(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     except StopIteration:
         raise FileFormatError(path, "is empty") from None
     rows = []
-    for i, cells in enumerate(reader):
+    for _i, cells in enumerate(reader):
         if not any(c.strip() for c in cells):
             continue
         row = dict(zip(header, cells))
@@ -287,11 +321,15 @@ def _flatten_json_record(rec: Mapping[str, Any], path: Path, row: int) -> dict[s
             flat.update(dict(zip(pose_columns(k), v)))
         elif k == "contacts":
             if not isinstance(v, Mapping):
-                raise FileFormatError(path, "contacts is an object {stage: [[x, y, z], ...]}", row, k)
+                raise FileFormatError(
+                    path, "contacts is an object {stage: [[x, y, z], ...]}", row, k
+                )
             for stage, pts in v.items():
                 for i, pt in enumerate(pts or []):
                     if not isinstance(pt, (list, tuple)) or len(pt) != 3:
-                        raise FileFormatError(path, "a contact point is [x, y, z]", row, f"contacts.{stage}[{i}]")
+                        raise FileFormatError(
+                            path, "a contact point is [x, y, z]", row, f"contacts.{stage}[{i}]"
+                        )
                     flat.update({f"{stage}_contact{i + 1}_{a}": c for a, c in zip("xyz", pt)})
         elif k == "extra" and isinstance(v, Mapping):
             flat.update({str(a): b for a, b in v.items()})

@@ -12,12 +12,17 @@ the ``reached_contactK_*`` points. Paths are relative to the results file.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
-from ..metrics.contact import DEFAULT_CONTACT_TOL, ContactError, contact_region_error, object_surface
+from ..metrics.contact import (
+    DEFAULT_CONTACT_TOL,
+    ContactError,
+    contact_region_error,
+    object_surface,
+)
 from ..metrics.inhand import METRICS, TrialScores, score_trials, summarize_scores
 from ..metrics.stats import GroupStats
 from .fileformat import FileFormatError
@@ -40,8 +45,10 @@ def _load_mesh(results: ResultSet, rel: str, row: int, column: str):
         raise FileFormatError(results.source, f"mesh file {rel!r} not found", row, column)
     try:
         mesh = trimesh.load(path, force="mesh")
-    except Exception as e:  # trimesh raises many kinds for bad files
-        raise FileFormatError(results.source, f"cannot read mesh {rel!r}: {e}", row, column) from None
+    except Exception as e:  # noqa: BLE001 - trimesh raises many kinds for bad files
+        raise FileFormatError(
+            results.source, f"cannot read mesh {rel!r}: {e}", row, column
+        ) from None
     return mesh
 
 
@@ -53,7 +60,9 @@ def _points(results: ResultSet, stage: str, i: int) -> np.ndarray | None:
     return pts if len(pts) else None
 
 
-def _contact_errors(results: ResultSet, method: str, contact_tol: float) -> list[ContactError | None] | None:
+def _contact_errors(
+    results: ResultSet, method: str, contact_tol: float
+) -> list[ContactError | None] | None:
     meshes = results.object_mesh
     if meshes is None or not any(meshes):
         return None
@@ -71,24 +80,37 @@ def _contact_errors(results: ResultSet, method: str, contact_tol: float) -> list
         region = results.desired_region[i] if results.desired_region is not None else ""
         if region.startswith("vertices:"):
             try:
-                desired = np.array([int(v) for v in region[len("vertices:"):].split(";") if v.strip()], dtype=np.int64)
+                desired = np.array(
+                    [int(v) for v in region[len("vertices:") :].split(";") if v.strip()],
+                    dtype=np.int64,
+                )
             except ValueError:
-                raise FileFormatError(results.source, "vertices: takes ;-separated integers", row, "desired_region") from None
+                raise FileFormatError(
+                    results.source, "vertices: takes ;-separated integers", row, "desired_region"
+                ) from None
         elif region:
             desired = _load_mesh(results, region, row, "desired_region")
         else:
             desired = _points(results, "desired", i)
         if links_col is not None and links_col[i]:
-            reached = [_load_mesh(results, p.strip(), row, "reached_links") for p in links_col[i].split(";") if p.strip()]
+            reached = [
+                _load_mesh(results, p.strip(), row, "reached_links")
+                for p in links_col[i].split(";")
+                if p.strip()
+            ]
         else:
             reached = _points(results, "reached", i)
         if desired is None or reached is None:
             out.append(None)
             continue
         try:
-            out.append(contact_region_error(surf, desired, reached, method=method, contact_tol=contact_tol))
+            out.append(
+                contact_region_error(surf, desired, reached, method=method, contact_tol=contact_tol)
+            )
         except (ValueError, IndexError) as e:
-            raise FileFormatError(results.source, f"contact error: {e}", row, "object_mesh") from None
+            raise FileFormatError(
+                results.source, f"contact error: {e}", row, "object_mesh"
+            ) from None
     return out
 
 

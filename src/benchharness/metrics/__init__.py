@@ -16,7 +16,7 @@ through the same code. Plotting lives in :mod:`benchharness.metrics.plots`
 """
 
 from .contact import ContactError, ObjectSurface, contact_region_error, object_surface
-from .inhand import TrialScores, score_trials, summarize_scores
+from .inhand import TrialScores, score_trials, summarize_scores  # noqa: F401 - public API
 from .pose import SetupCheck, err_or_percent, err_pos, err_pos_percent, setup_check
 from .rubiks import RubiksTrial, TierScore, TrialResult, mean_and_std, score_tier, score_trial
 from .stats import BoxStats, box_stats, drops_percent, summarize_groups

@@ -46,8 +46,9 @@ from __future__ import annotations
 
 import hashlib
 from collections import OrderedDict
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal, Sequence, Union
+from typing import Literal
 
 import numpy as np
 import trimesh
@@ -69,7 +70,7 @@ DEFAULT_CONTACT_TOL = 2e-3
 GeodesicMethod = Literal["heat", "exact"]
 #: A region or robot contact: a mesh, several meshes (robot links), object
 #: vertex indices (integer 1-D array), or points ((n, 3) float array).
-ContactSpec = Union[trimesh.Trimesh, Sequence[trimesh.Trimesh], np.ndarray, Sequence[Sequence[float]]]
+ContactSpec = trimesh.Trimesh | Sequence[trimesh.Trimesh] | np.ndarray | Sequence[Sequence[float]]
 
 
 @dataclass(frozen=True)
@@ -142,7 +143,9 @@ class ObjectSurface:
         _, idx = self.tree.query(pts)
         return np.asarray(idx, dtype=np.int64)
 
-    def intersect(self, part: trimesh.Trimesh, contact_tol: float = DEFAULT_CONTACT_TOL) -> np.ndarray:
+    def intersect(
+        self, part: trimesh.Trimesh, contact_tol: float = DEFAULT_CONTACT_TOL
+    ) -> np.ndarray:
         """``intersect``: points of ``part`` within ``contact_tol`` of the surface."""
         v, f = np.asarray(part.vertices, float), np.asarray(part.faces, np.int64)
         if len(f):
@@ -165,7 +168,9 @@ class ObjectSurface:
             try:
                 from pygeodesic import geodesic
             except ImportError as e:  # pragma: no cover - optional dependency
-                raise ImportError("method='exact' needs pygeodesic: pip install 'benchharness[exact]'") from e
+                raise ImportError(
+                    "method='exact' needs pygeodesic: pip install 'benchharness[exact]'"
+                ) from e
             self._exact = geodesic.PyGeodesicAlgorithmExact(self.vertices, self.faces)
         return self._exact
 
@@ -188,29 +193,41 @@ class ObjectSurface:
         ring = ring[inside[ring]]
         return ring if len(ring) else np.asarray(vertices)
 
-    def geodesic_to_set(self, sources: np.ndarray, targets: np.ndarray, method: GeodesicMethod = "heat") -> np.ndarray:
+    def geodesic_to_set(
+        self, sources: np.ndarray, targets: np.ndarray, method: GeodesicMethod = "heat"
+    ) -> np.ndarray:
         """Distance along the surface from each target vertex to the nearest source vertex."""
         sources = np.unique(np.asarray(sources, dtype=np.int64))
         targets = np.asarray(targets, dtype=np.int64)
         if len(sources) == 0 or len(targets) == 0:
             return np.full(len(targets), np.nan)
         if method == "heat":
-            d = self.heat_solver().compute_distance_multisource(self.region_boundary(sources).tolist())
+            d = self.heat_solver().compute_distance_multisource(
+                self.region_boundary(sources).tolist()
+            )
             out = np.asarray(d, dtype=float)[targets]
             out[np.isin(targets, sources)] = 0.0
             return out
         if method == "exact":
-            d, _ = self.exact_solver().geodesicDistances(sources.astype(np.int32), targets.astype(np.int32))
+            d, _ = self.exact_solver().geodesicDistances(
+                sources.astype(np.int32), targets.astype(np.int32)
+            )
             d = np.asarray(d, dtype=float)
             d[~np.isfinite(d) | (d > 1e30)] = np.nan  # unreachable: other component
             return d
         raise ValueError(f"unknown geodesic method {method!r} (heat or exact)")
 
-    def vertices_of(self, spec: ContactSpec, contact_tol: float = DEFAULT_CONTACT_TOL) -> np.ndarray:
+    def vertices_of(
+        self, spec: ContactSpec, contact_tol: float = DEFAULT_CONTACT_TOL
+    ) -> np.ndarray:
         """Object vertices for a region / contact given in any accepted form."""
         if isinstance(spec, trimesh.Trimesh):
             return np.unique(self.min_vertex(self.intersect(spec, contact_tol)))
-        if isinstance(spec, (list, tuple)) and spec and all(isinstance(m, trimesh.Trimesh) for m in spec):
+        if (
+            isinstance(spec, (list, tuple))
+            and spec
+            and all(isinstance(m, trimesh.Trimesh) for m in spec)
+        ):
             parts = [self.min_vertex(self.intersect(m, contact_tol)) for m in spec]
             return np.unique(np.concatenate(parts))
         arr = np.asarray(spec)
@@ -223,7 +240,7 @@ class ObjectSurface:
         return np.unique(self.min_vertex(arr))
 
 
-_CACHE: "OrderedDict[str, ObjectSurface]" = OrderedDict()
+_CACHE: OrderedDict[str, ObjectSurface] = OrderedDict()
 _CACHE_SIZE = 16
 
 
@@ -285,9 +302,13 @@ def contact_region_error(
     v_c = surf.vertices_of(desired, contact_tol)
     p_r = surf.vertices_of(reached, contact_tol)
     if len(v_c) == 0:
-        raise ValueError("the desired contact region maps to no object vertex (intersect() found nothing)")
+        raise ValueError(
+            "the desired contact region maps to no object vertex (intersect() found nothing)"
+        )
     if len(p_r) == 0:
-        raise ValueError("the robot contact maps to no object vertex (nothing within contact_tol of the object)")
+        raise ValueError(
+            "the robot contact maps to no object vertex (nothing within contact_tol of the object)"
+        )
     euc, k_e = euclidean_max_min(surf.vertices[p_r], surf.vertices[v_c])
     geo_d = surf.geodesic_to_set(v_c, p_r, method)
     if np.all(np.isnan(geo_d)):

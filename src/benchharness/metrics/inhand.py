@@ -8,13 +8,20 @@ real-robot user can call :func:`score_trials` on their own logs directly; the
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
 
 import numpy as np
 
 from .contact import ContactError
-from .pose import SETUP_THRESHOLD_PERCENT, SetupCheck, err_or_percent, err_pos, err_pos_percent, setup_check
+from .pose import (
+    SETUP_THRESHOLD_PERCENT,
+    SetupCheck,
+    err_or_percent,
+    err_pos,
+    err_pos_percent,
+    setup_check,
+)
 from .stats import GroupStats, summarize_groups
 
 __all__ = ["TrialScores", "score_trials", "summarize_scores", "METRICS", "MetricInfo"]
@@ -110,8 +117,13 @@ def score_trials(
     rea[drop] = np.nan
     su = np.full((n, 7), np.nan) if setup is None else np.atleast_2d(np.asarray(setup, float))
     check = setup_check(
-        ini[:, :3], ini[:, 3:], su[:, :3], su[:, 3:], des[:, :3],
-        threshold_percent=setup_threshold_percent, normalize=normalize,
+        ini[:, :3],
+        ini[:, 3:],
+        su[:, :3],
+        su[:, 3:],
+        des[:, :3],
+        threshold_percent=setup_threshold_percent,
+        normalize=normalize,
     )
     nan = np.full(n, np.nan)
     g = {k: nan.copy() for k in ("euc", "geo", "min")}

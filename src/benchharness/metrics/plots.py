@@ -10,9 +10,9 @@ points. Uses the object-oriented matplotlib API with the Agg canvas, never
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -36,8 +36,16 @@ class BoxPlot:
 
 def _scaled(b: BoxStats, s: float) -> BoxStats:
     return BoxStats(
-        b.n, b.median * s, b.q1 * s, b.q3 * s, b.whisker_low * s, b.whisker_high * s,
-        b.minimum * s, b.maximum * s, b.mean * s, tuple(v * s for v in b.outliers),
+        b.n,
+        b.median * s,
+        b.q1 * s,
+        b.q3 * s,
+        b.whisker_low * s,
+        b.whisker_high * s,
+        b.minimum * s,
+        b.maximum * s,
+        b.mean * s,
+        tuple(v * s for v in b.outliers),
     )
 
 
@@ -76,7 +84,12 @@ def box_plot(
     colours = [f"C{i % 10}" for i in range(len(hues))]
     width = 0.8 / max(len(hues), 1)
 
-    fig = Figure(figsize=(min(16.0, max(6.0, 0.35 * len(groups) * max(len(hues), 1) + 2.0)), 3.0 * len(shown) + 0.9))
+    fig = Figure(
+        figsize=(
+            min(16.0, max(6.0, 0.35 * len(groups) * max(len(hues), 1) + 2.0)),
+            3.0 * len(shown) + 0.9,
+        )
+    )
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(shown), 1, sharex=True, squeeze=False)[:, 0]
     artists: dict[str, dict] = {}
@@ -92,7 +105,11 @@ def box_plot(
                 positions.append(g + (h - (len(hues) - 1) / 2) * width)
                 faces.append(colours[h])
         art = ax.bxp(
-            stats, positions=positions, widths=width * 0.85, patch_artist=True, showfliers=True,
+            stats,
+            positions=positions,
+            widths=width * 0.85,
+            patch_artist=True,
+            showfliers=True,
             medianprops={"color": "black", "linewidth": 1.4},
             flierprops={"marker": "o", "markersize": 3, "markerfacecolor": "none"},
         )
@@ -113,7 +130,9 @@ def box_plot(
     rows = -(-len(hues) // ncol)
     fig.legend(
         handles=[Patch(facecolor=c, alpha=0.75, label=h) for h, c in zip(hues, colours)],
-        loc="upper center", ncol=ncol, frameon=False,
+        loc="upper center",
+        ncol=ncol,
+        frameon=False,
         title=title,
     )
     fig.tight_layout(rect=(0, 0, 1, 1 - (0.3 + 0.25 * rows) / fig.get_figheight()))

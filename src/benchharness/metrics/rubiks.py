@@ -32,14 +32,15 @@ import io
 import json
 import math
 import statistics
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any
 
 from ..cube import (
+    SOLVED_STRING,
     FaceletError,
     MoveError,
-    SOLVED_STRING,
     UnknownTierError,
     differences,
     expected_final,
@@ -51,7 +52,16 @@ from ..cube import (
 )
 
 #: Columns of the CSV log (and keys of the JSON log's trial objects).
-LOG_FIELDS = ("tier", "trial", "initial", "sequence", "final", "first_contact_s", "termination_s", "note")
+LOG_FIELDS = (
+    "tier",
+    "trial",
+    "initial",
+    "sequence",
+    "final",
+    "first_contact_s",
+    "termination_s",
+    "note",
+)
 REQUIRED_FIELDS = ("tier", "trial", "sequence", "final")
 
 
@@ -158,11 +168,11 @@ def score_trial(trial: RubiksTrial, seed: int | None = None) -> TrialResult:
             n_moves = get_tier(trial.tier).moves
         except UnknownTierError as exc:
             raise TrialLogError(f"{where}: {exc}") from exc
-        prescribed = generate_sequence(seed, trial.tier, trial.trial, n_moves) if trial.trial >= 1 else ()
+        prescribed = (
+            generate_sequence(seed, trial.tier, trial.trial, n_moves) if trial.trial >= 1 else ()
+        )
         if tuple(moves) != prescribed:
-            reason = (
-                f"the sequence is not the generator's for seed {seed}, {trial.tier}, trial {trial.trial}"
-            )
+            reason = f"the sequence is not the generator's for seed {seed}, {trial.tier}, trial {trial.trial}"
     if not reason and problems:
         reason = "observed final state is not a legal cube: " + "; ".join(problems)
     if not reason and trial.final != expected:
@@ -172,7 +182,9 @@ def score_trial(trial: RubiksTrial, seed: int | None = None) -> TrialResult:
     score = None
     if success:
         if trial.first_contact_s is None or trial.termination_s is None:
-            raise TrialLogError(f"{where}: a successful trial needs first_contact_s and termination_s")
+            raise TrialLogError(
+                f"{where}: a successful trial needs first_contact_s and termination_s"
+            )
         score = trial.termination_s - trial.first_contact_s
         if not math.isfinite(score) or score < 0:
             raise TrialLogError(
@@ -181,8 +193,12 @@ def score_trial(trial: RubiksTrial, seed: int | None = None) -> TrialResult:
     return TrialResult(trial, expected, success, score, reason)
 
 
-def score_tier(trials: Iterable[RubiksTrial], tier: str, trials_required: int | None = None,
-               seed: int | None = None) -> TierScore:
+def score_tier(
+    trials: Iterable[RubiksTrial],
+    tier: str,
+    trials_required: int | None = None,
+    seed: int | None = None,
+) -> TierScore:
     """Score the trials of one tier. ``trials_required`` defaults to the tier's M."""
     try:
         known = get_tier(tier)
@@ -200,9 +216,13 @@ def score_tier(trials: Iterable[RubiksTrial], tier: str, trials_required: int | 
     repeated = sorted({k for k in numbers if numbers.count(k) > 1})
     extra = sorted({k for k in numbers if not 1 <= k <= trials_required})
     if missing:
-        problems.append(f"trial{'s' if len(missing) > 1 else ''} {', '.join(map(str, missing))} not logged")
+        problems.append(
+            f"trial{'s' if len(missing) > 1 else ''} {', '.join(map(str, missing))} not logged"
+        )
     if repeated:
-        problems.append(f"trial{'s' if len(repeated) > 1 else ''} {', '.join(map(str, repeated))} logged more than once")
+        problems.append(
+            f"trial{'s' if len(repeated) > 1 else ''} {', '.join(map(str, repeated))} logged more than once"
+        )
     if extra:
         problems.append(
             f"trial{'s' if len(extra) > 1 else ''} {', '.join(map(str, extra))} outside 1..{trials_required}"
@@ -251,15 +271,19 @@ def _float(value: Any, where: str, name: str) -> float | None:
     return out
 
 
-def trial_from_record(rec: dict[str, Any], where: str, default_tier: str | None = None) -> RubiksTrial:
+def trial_from_record(
+    rec: dict[str, Any], where: str, default_tier: str | None = None
+) -> RubiksTrial:
     """Build a :class:`RubiksTrial` from one CSV row or JSON object."""
     rec = {k.strip() if isinstance(k, str) else k: v for k, v in rec.items()}
     if default_tier and not rec.get("tier"):
         rec["tier"] = default_tier
     unknown = sorted(k for k in rec if k not in LOG_FIELDS)
     if unknown:
-        raise TrialLogError(f"{where}: unknown field{'s' if len(unknown) > 1 else ''} {', '.join(map(str, unknown))}; "
-                            f"fields are {', '.join(LOG_FIELDS)}")
+        raise TrialLogError(
+            f"{where}: unknown field{'s' if len(unknown) > 1 else ''} {', '.join(map(str, unknown))}; "
+            f"fields are {', '.join(LOG_FIELDS)}"
+        )
     missing = [k for k in REQUIRED_FIELDS if rec.get(k) in (None, "")]
     if missing:
         raise TrialLogError(f"{where}: missing {', '.join(missing)}")
@@ -267,7 +291,9 @@ def trial_from_record(rec: dict[str, Any], where: str, default_tier: str | None 
     try:
         trial_no = int(str(raw_trial).strip())
     except ValueError:
-        raise TrialLogError(f"{where}: trial must be an integer (1-based), got {raw_trial!r}") from None
+        raise TrialLogError(
+            f"{where}: trial must be an integer (1-based), got {raw_trial!r}"
+        ) from None
     sequence = rec["sequence"]
     if isinstance(sequence, list):
         sequence = " ".join(map(str, sequence))
@@ -308,7 +334,9 @@ def parse_json_log(text: str) -> list[RubiksTrial]:
         default_tier = data.get("tier")
         data = data.get("trials")
     if not isinstance(data, list):
-        raise TrialLogError('a JSON log is a list of trial objects, or an object with a "trials" list')
+        raise TrialLogError(
+            'a JSON log is a list of trial objects, or an object with a "trials" list'
+        )
     out = []
     for i, rec in enumerate(data, start=1):
         if not isinstance(rec, dict):

@@ -11,12 +11,19 @@ drawn cannot disagree.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["BoxStats", "box_stats", "group_indices", "GroupStats", "summarize_groups", "drops_percent"]
+__all__ = [
+    "BoxStats",
+    "box_stats",
+    "group_indices",
+    "GroupStats",
+    "summarize_groups",
+    "drops_percent",
+]
 
 
 @dataclass(frozen=True)
@@ -54,7 +61,9 @@ class BoxStats:
 
 def box_stats(values: Iterable[float], whis: float = 1.5) -> BoxStats:
     """Box-plot statistics; an empty sample (or all-NaN) gives NaNs and ``n=0``."""
-    x = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, dtype=float).ravel()
+    x = np.asarray(
+        list(values) if not isinstance(values, np.ndarray) else values, dtype=float
+    ).ravel()
     x = x[np.isfinite(x)]
     if len(x) == 0:
         nan = float("nan")
@@ -81,7 +90,9 @@ def box_stats(values: Iterable[float], whis: float = 1.5) -> BoxStats:
     )
 
 
-def group_indices(columns: Mapping[str, Sequence], by: Sequence[str]) -> list[tuple[tuple[str, ...], np.ndarray]]:
+def group_indices(
+    columns: Mapping[str, Sequence], by: Sequence[str]
+) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """Row indices per distinct key of the ``by`` columns, in order of first appearance.
 
     First appearance, not sorted order, so that tables and plots follow the

@@ -35,7 +35,9 @@ class AABox:
     hi: tuple[float, float, float]
 
     @classmethod
-    def centred(cls, size: tuple[float, float, float], centre: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> "AABox":
+    def centred(
+        cls, size: tuple[float, float, float], centre: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    ) -> AABox:
         s = np.asarray(size, float) / 2
         c = np.asarray(centre, float)
         return cls(tuple(c - s), tuple(c + s))

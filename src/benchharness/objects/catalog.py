@@ -36,7 +36,7 @@ frames; relative hand motions (``T = H_d H_i^-1``) are unaffected.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

@@ -14,8 +14,8 @@ overlap would be counted twice.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 import trimesh
@@ -98,4 +98,6 @@ def mass_properties(shapes: Sequence[Shape], mass: float) -> MassProperties:
     for v, c, i_unit in parts:
         d = c - com
         inertia += rho * (i_unit + v * (np.dot(d, d) * np.eye(3) - np.outer(d, d)))
-    return MassProperties(mass=float(mass), com=np.asarray(com, float), inertia=inertia, volume=float(vol))
+    return MassProperties(
+        mass=float(mass), com=np.asarray(com, float), inertia=inertia, volume=float(vol)
+    )

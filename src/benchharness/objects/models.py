@@ -195,14 +195,17 @@ def _build_sweep(geom: SweepGeometry, h: float) -> tuple[trimesh.Trimesh, list[S
         shapes = []
         for hull in hulls:
             hull.apply_transform(tf)
-            shapes.append(MeshShape(vertices=np.asarray(hull.vertices), faces=np.asarray(hull.faces)))
+            shapes.append(
+                MeshShape(vertices=np.asarray(hull.vertices), faces=np.asarray(hull.faces))
+            )
     return mesh, shapes
 
 
 def _build_boxes(geom: BoxGeometry, h: float) -> tuple[trimesh.Trimesh, list[Shape]]:
     mesh = mesh_box_union(list(geom.boxes), h)
     shapes: list[Shape] = [
-        Box(half_extents=tuple(float(v) for v in b.size / 2), pose=Pose(b.centre)) for b in geom.boxes
+        Box(half_extents=tuple(float(v) for v in b.size / 2), pose=Pose(b.centre))
+        for b in geom.boxes
     ]
     return mesh, shapes
 
@@ -240,7 +243,9 @@ def _from_mesh(spec: ObjectSpec, path: Path, collision: CollisionMode) -> Object
         hulls = [p if isinstance(p, trimesh.Trimesh) else trimesh.Trimesh(**p) for p in parts]
     else:
         raise ValueError(f"collision must be 'hull' or 'decompose', not {collision!r}")
-    shapes: list[Shape] = [MeshShape(vertices=np.asarray(h.vertices), faces=np.asarray(h.faces)) for h in hulls]
+    shapes: list[Shape] = [
+        MeshShape(vertices=np.asarray(h.vertices), faces=np.asarray(h.faces)) for h in hulls
+    ]
     return ObjectModel(
         spec=spec,
         surface=surface,

@@ -60,7 +60,9 @@ class ContactRegion:
         return float(self.mesh.area)
 
 
-def vertex_distances(mesh: trimesh.Trimesh, point: np.ndarray, metric: RegionMetric = "geodesic") -> tuple[np.ndarray, np.ndarray, int]:
+def vertex_distances(
+    mesh: trimesh.Trimesh, point: np.ndarray, metric: RegionMetric = "geodesic"
+) -> tuple[np.ndarray, np.ndarray, int]:
     """Distances from the surface point nearest ``point`` to every vertex.
 
     Returns ``(distances, projected_point, snapped_vertex)``.
@@ -74,18 +76,24 @@ def vertex_distances(mesh: trimesh.Trimesh, point: np.ndarray, metric: RegionMet
     elif metric == "geodesic":
         import potpourri3d as pp3d
 
-        solver = pp3d.MeshHeatMethodDistanceSolver(np.asarray(mesh.vertices), np.asarray(mesh.faces))
+        solver = pp3d.MeshHeatMethodDistanceSolver(
+            np.asarray(mesh.vertices), np.asarray(mesh.faces)
+        )
         d = np.asarray(solver.compute_distance(v))
     elif metric == "geodesic_exact":
         try:
             import pygeodesic.geodesic as geodesic
         except ImportError as exc:  # pragma: no cover - optional dependency
-            raise ImportError("metric='geodesic_exact' needs pygeodesic (pip install benchharness[exact])") from exc
+            raise ImportError(
+                "metric='geodesic_exact' needs pygeodesic (pip install benchharness[exact])"
+            ) from exc
         alg = geodesic.PyGeodesicAlgorithmExact(np.asarray(mesh.vertices), np.asarray(mesh.faces))
         d, _ = alg.geodesicDistances(np.array([v]), None)
         d = np.asarray(d)
     else:
-        raise ValueError(f"metric must be 'euclidean', 'geodesic' or 'geodesic_exact', not {metric!r}")
+        raise ValueError(
+            f"metric must be 'euclidean', 'geodesic' or 'geodesic_exact', not {metric!r}"
+        )
     return d, centre, v
 
 

@@ -29,8 +29,8 @@ the tests check the mesh against.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 import trimesh
@@ -88,7 +88,9 @@ class SweptMesh:
 
     mesh: trimesh.Trimesh
     ring_x: np.ndarray
-    ring_slices: list[slice]  #: vertices of main ring k (cap rings lie inside the end rings, so hulls ignore them)
+    ring_slices: list[
+        slice
+    ]  #: vertices of main ring k (cap rings lie inside the end rings, so hulls ignore them)
     cap_slices: tuple[slice | None, slice | None] = field(default=(None, None))
 
 
@@ -129,7 +131,11 @@ def _ring_positions(samples: np.ndarray, h: float) -> np.ndarray:
     th = np.linspace(0, 2 * np.pi, 24, endpoint=False)
     x, a, b, zc = samples.T
     pts = np.stack(
-        [np.repeat(x[:, None], th.size, 1), a[:, None] * np.cos(th), zc[:, None] + b[:, None] * np.sin(th)],
+        [
+            np.repeat(x[:, None], th.size, 1),
+            a[:, None] * np.cos(th),
+            zc[:, None] + b[:, None] * np.sin(th),
+        ],
         axis=-1,
     )
     step = np.linalg.norm(np.diff(pts, axis=0), axis=-1).max(axis=1)
@@ -142,7 +148,9 @@ def _ring_positions(samples: np.ndarray, h: float) -> np.ndarray:
     return np.column_stack([np.interp(targets, dist, col) for col in samples.T])
 
 
-def _zip(ia: np.ndarray, fa: np.ndarray, ib: np.ndarray, fb: np.ndarray) -> list[tuple[int, int, int]]:
+def _zip(
+    ia: np.ndarray, fa: np.ndarray, ib: np.ndarray, fb: np.ndarray
+) -> list[tuple[int, int, int]]:
     """Triangulate the band between two closed rings by advancing the earlier next point."""
     faces: list[tuple[int, int, int]] = []
     na, nb = len(ia), len(ib)
@@ -161,7 +169,9 @@ def _zip(ia: np.ndarray, fa: np.ndarray, ib: np.ndarray, fb: np.ndarray) -> list
     return faces
 
 
-def _zip_open(upper: np.ndarray, lower: np.ndarray, y_of_ring: np.ndarray) -> list[tuple[int, int, int]]:
+def _zip_open(
+    upper: np.ndarray, lower: np.ndarray, y_of_ring: np.ndarray
+) -> list[tuple[int, int, int]]:
     """Triangulate between two polylines sharing both end points, paired by y."""
     base = int(upper[0])
     fu = -y_of_ring[upper - base]
@@ -249,7 +259,9 @@ def mesh_sweep(profile: SweepProfile, h: float, pole_tol: float = 1e-7) -> Swept
 
     mesh = trimesh.Trimesh(np.vstack(verts), np.asarray(faces, dtype=np.int64), process=False)
     mesh.fix_normals()
-    return SweptMesh(mesh=mesh, ring_x=ring_x, ring_slices=slices[:n_main], cap_slices=(caps[0], caps[1]))
+    return SweptMesh(
+        mesh=mesh, ring_x=ring_x, ring_slices=slices[:n_main], cap_slices=(caps[0], caps[1])
+    )
 
 
 def piece_vertex_sets(swept: SweptMesh, profile: SweepProfile) -> list[np.ndarray]:
@@ -279,7 +291,9 @@ def piece_vertex_sets(swept: SweptMesh, profile: SweepProfile) -> list[np.ndarra
         length = xs[left_end] - xs[start]
         m = max(1, int(np.ceil(length / profile.max_piece_length - tol)))
         targets = xs[start] + np.arange(1, m) * length / m
-        inner = sorted({int(np.argmin(np.abs(xs[start : left_end + 1] - t))) + start for t in targets})
+        inner = sorted(
+            {int(np.argmin(np.abs(xs[start : left_end + 1] - t))) + start for t in targets}
+        )
         edges = [start] + [k for k in inner if start < k < left_end] + [left_end]
         bounds += list(zip(edges[:-1], edges[1:]))
         start = right_start
@@ -287,7 +301,10 @@ def piece_vertex_sets(swept: SweptMesh, profile: SweepProfile) -> list[np.ndarra
     for k0, k1 in bounds:
         if k1 <= k0:
             continue
-        sl = [np.arange(swept.ring_slices[k].start, swept.ring_slices[k].stop) for k in range(k0, k1 + 1)]
+        sl = [
+            np.arange(swept.ring_slices[k].start, swept.ring_slices[k].stop)
+            for k in range(k0, k1 + 1)
+        ]
         sets.append(np.concatenate(sl))
     return sets
 
@@ -303,5 +320,3 @@ def pieces_as_meshes(swept: SweptMesh, profile: SweepProfile) -> list[trimesh.Tr
         if hull.volume > 0:
             out.append(hull)
     return out
-
-

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import importlib
 import threading
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from importlib import metadata
 from types import ModuleType
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import pluggy
 
@@ -147,7 +148,9 @@ class PluginManager:
                 regs = impl()
             except Exception as exc:  # noqa: BLE001 - a plugin's hook raising is isolated
                 self.errors.append(
-                    PluginLoadError(label, distribution, f"hook {hook_name} raised {type(exc).__name__}: {exc}")
+                    PluginLoadError(
+                        label, distribution, f"hook {hook_name} raised {type(exc).__name__}: {exc}"
+                    )
                 )
                 continue
             for reg in regs or []:
@@ -156,7 +159,9 @@ class PluginManager:
     def _add(self, kind: str, reg: Registration, label: str, dist: str) -> None:
         if not isinstance(reg, Registration):
             self.errors.append(
-                PluginLoadError(label, dist, f"{kind} hook returned {type(reg).__name__}, not Registration")
+                PluginLoadError(
+                    label, dist, f"{kind} hook returned {type(reg).__name__}, not Registration"
+                )
             )
             return
         key = (kind, reg.name)
@@ -171,7 +176,9 @@ class PluginManager:
                 )
             )
             return
-        self._items[key] = Item(kind, reg.name, reg.factory, reg.summary, dist, label, dict(reg.meta))
+        self._items[key] = Item(
+            kind, reg.name, reg.factory, reg.summary, dist, label, dict(reg.meta)
+        )
 
     # -- queries -----------------------------------------------------------
     def items(self, kind: str | None = None) -> list[Item]:

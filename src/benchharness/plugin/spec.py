@@ -23,8 +23,9 @@ and in that distribution's ``pyproject.toml``::
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import pluggy
 

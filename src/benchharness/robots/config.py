@@ -13,9 +13,10 @@ differ from ours.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Literal, Mapping, Sequence
+from typing import Literal
 
 import numpy as np
 
@@ -30,13 +31,19 @@ class ArmConfig:
 
     name: str  #: group name, e.g. ``"left_arm"``, ``"index"``
     joints: tuple[str, ...]  #: movable joints from base to tip (the chain's order)
-    base_link: str  #: IK targets are expressed in this link's frame (converted from world by the robot)
+    base_link: (
+        str  #: IK targets are expressed in this link's frame (converted from world by the robot)
+    )
     tcp_link: str  #: tool-centre-point frame (a URDF link)
     stiffness: tuple[float, ...]  #: PD stiffness per joint (N m/rad or N/m)
     damping: tuple[float, ...]  #: PD damping per joint (N m s/rad or N s/m)
     position_only: bool = False  #: IK on position only (fingers with < 6 DOF)
-    velocity_scale: float = 0.5  #: trajectories use this fraction of each joint's URDF velocity limit
-    gravity_carried: bool = False  #: gravity torque is carried by a counterbalance, not by the motors (PR2)
+    velocity_scale: float = (
+        0.5  #: trajectories use this fraction of each joint's URDF velocity limit
+    )
+    gravity_carried: bool = (
+        False  #: gravity torque is carried by a counterbalance, not by the motors (PR2)
+    )
 
 
 @dataclass(frozen=True)
@@ -53,11 +60,15 @@ class GripperConfig:
 
     name: str  #: group name, e.g. ``"left_gripper"``
     joints: tuple[str, ...]  #: physical joints
-    actuators: tuple[str, ...]  #: command names, e.g. ``("grip",)``, ``("spread", "f1", "f2", "f3")``
+    actuators: tuple[
+        str, ...
+    ]  #: command names, e.g. ``("grip",)``, ``("spread", "f1", "f2", "f3")``
     coupling: tuple[tuple[float, ...], ...]  #: (len(joints), len(actuators)) matrix
     open: tuple[float, ...]  #: actuator values of the open hand
     closed: tuple[float, ...]  #: actuator values of the fully closed hand (no object)
-    grasp_actuators: tuple[str, ...]  #: actuators that close() moves (others keep their value, e.g. spread)
+    grasp_actuators: tuple[
+        str, ...
+    ]  #: actuators that close() moves (others keep their value, e.g. spread)
     stiffness: tuple[float, ...]  #: per joint
     damping: tuple[float, ...]  #: per joint
     force_limit: tuple[float, ...]  #: default per-joint force/torque cap for closing (N or N m)
@@ -80,9 +91,15 @@ class RobotConfig:
     urdf: Path
     arms: tuple[ArmConfig, ...] = ()
     grippers: tuple[GripperConfig, ...] = ()
-    extra_groups: Mapping[str, tuple[str, ...]] = field(default_factory=dict)  #: e.g. ``{"torso": ("torso_lift_joint",)}``
-    extra_gains: Mapping[str, tuple[float, float]] = field(default_factory=dict)  #: joint -> (stiffness, damping) for joints outside arms/grippers
-    home: Mapping[str, float] = field(default_factory=dict)  #: joint -> position; unnamed joints home at 0 (clamped to limits)
+    extra_groups: Mapping[str, tuple[str, ...]] = field(
+        default_factory=dict
+    )  #: e.g. ``{"torso": ("torso_lift_joint",)}``
+    extra_gains: Mapping[str, tuple[float, float]] = field(
+        default_factory=dict
+    )  #: joint -> (stiffness, damping) for joints outside arms/grippers
+    home: Mapping[str, float] = field(
+        default_factory=dict
+    )  #: joint -> position; unnamed joints home at 0 (clamped to limits)
     base_pose: Pose = field(default_factory=Pose)  #: world pose of the URDF root link
     fixed_base: bool = True
     summary: str = ""
@@ -99,7 +116,7 @@ class RobotConfig:
         urdf: str | Path,
         joint_map: Mapping[str, str] | None = None,
         link_map: Mapping[str, str] | None = None,
-    ) -> "RobotConfig":
+    ) -> RobotConfig:
         """The same robot on another URDF whose joint/link names differ by the given maps.
 
         Maps go from our names to the names in ``urdf``; names not in a map
@@ -117,7 +134,12 @@ class RobotConfig:
             return None if n is None else lm.get(n, n)
 
         arms = tuple(
-            replace(a, joints=tuple(j(n) for n in a.joints), base_link=lk(a.base_link), tcp_link=lk(a.tcp_link))
+            replace(
+                a,
+                joints=tuple(j(n) for n in a.joints),
+                base_link=lk(a.base_link),
+                tcp_link=lk(a.tcp_link),
+            )
             for a in self.arms
             if all(j(n) for n in a.joints)
         )
@@ -134,11 +156,20 @@ class RobotConfig:
         extra = {k: tuple(j(n) for n in v if j(n)) for k, v in self.extra_groups.items()}
         gains = {j(k): v for k, v in self.extra_gains.items() if j(k)}
         home = {j(k): v for k, v in self.home.items() if j(k)}
-        return replace(self, urdf=Path(urdf), arms=arms, grippers=grippers, extra_groups=extra,
-                       extra_gains=gains, home=home)
+        return replace(
+            self,
+            urdf=Path(urdf),
+            arms=arms,
+            grippers=grippers,
+            extra_groups=extra,
+            extra_gains=gains,
+            home=home,
+        )
 
 
-def gains_from_effort(efforts: Sequence[float], kp_per_effort: float, kd_per_effort: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+def gains_from_effort(
+    efforts: Sequence[float], kp_per_effort: float, kd_per_effort: float
+) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """PD gains proportional to each joint's effort limit.
 
     Why: stiff joints where the motor is strong and soft where it is weak

@@ -33,10 +33,24 @@ def read_joints(urdf: str | Path) -> list[UrdfJoint]:
         if t not in MOVABLE:
             continue
         lim = j.find("limit")
-        get = (lambda k, d: float(lim.get(k, d))) if lim is not None else (lambda k, d: float(d))
-        lo, hi = (get("lower", 0.0), get("upper", 0.0)) if t != "continuous" else (-math.inf, math.inf)
-        out.append(UrdfJoint(j.get("name"), t, j.find("parent").get("link"), j.find("child").get("link"),
-                             lo, hi, get("velocity", math.inf), get("effort", math.inf)))
+        if t == "continuous":
+            lo, hi = -math.inf, math.inf
+        elif lim is not None:
+            lo, hi = float(lim.get("lower", 0.0)), float(lim.get("upper", 0.0))
+        else:
+            lo, hi = 0.0, 0.0
+        out.append(
+            UrdfJoint(
+                j.get("name"),
+                t,
+                j.find("parent").get("link"),
+                j.find("child").get("link"),
+                lo,
+                hi,
+                float(lim.get("velocity", math.inf)) if lim is not None else math.inf,
+                float(lim.get("effort", math.inf)) if lim is not None else math.inf,
+            )
+        )
     return out
 
 

@@ -14,8 +14,8 @@ downstream of j (revolute: ``a_j x (c_i - o_j)``; prismatic: ``a_j``).
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -39,7 +39,9 @@ class GravityModel:
             m = inertial.find("mass")
             o = inertial.find("origin")
             self.mass[link.get("name")] = float(m.get("value")) if m is not None else 0.0
-            self.com[link.get("name")] = np.array([float(x) for x in (o.get("xyz", "0 0 0") if o is not None else "0 0 0").split()])
+            self.com[link.get("name")] = np.array(
+                [float(x) for x in (o.get("xyz", "0 0 0") if o is not None else "0 0 0").split()]
+            )
         children: dict[str, list[tuple[str, str]]] = {}
         self.joints: dict[str, tuple[str, str, np.ndarray]] = {}  # name -> (type, child, axis)
         for j in root.findall("joint"):
@@ -47,7 +49,9 @@ class GravityModel:
             child = j.find("child").get("link")
             children.setdefault(parent, []).append((j.get("name"), child))
             ax = j.find("axis")
-            axis = np.array([float(x) for x in (ax.get("xyz") if ax is not None else "1 0 0").split()])
+            axis = np.array(
+                [float(x) for x in (ax.get("xyz") if ax is not None else "1 0 0").split()]
+            )
             self.joints[j.get("name")] = (j.get("type"), child, axis / np.linalg.norm(axis))
         self.downstream: dict[str, list[str]] = {}
         for name, (_, child, _) in self.joints.items():
@@ -69,7 +73,9 @@ class GravityModel:
             w[[index[lk] for lk in links]] = 1.0
             self._row[name] = w
 
-    def torques(self, q: Mapping[str, float], joints: Sequence[str], base_rotation: np.ndarray | None = None) -> np.ndarray:
+    def torques(
+        self, q: Mapping[str, float], joints: Sequence[str], base_rotation: np.ndarray | None = None
+    ) -> np.ndarray:
         """Holding torques (N m or N) of ``joints`` at configuration ``q``.
 
         ``base_rotation`` is the world rotation of the URDF root (gravity is

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 from ..geometry import Pose
 from ..paths import robots_dir
@@ -16,8 +16,16 @@ __all__ = ["herb_config", "make_herb", "BARRETT_HAND_COUPLING"]
 #: Physical joints of one hand (after the side prefix) and the coupling from the actuators
 #: (spread, f1, f2, f3): spread drives both F1 and F2 knuckles; each distal joint follows its
 #: proximal joint at the BH8-280 ratio.
-HAND_JOINTS = ("bh_j11_joint", "bh_j21_joint", "bh_j12_joint", "bh_j13_joint",
-               "bh_j22_joint", "bh_j23_joint", "bh_j32_joint", "bh_j33_joint")
+HAND_JOINTS = (
+    "bh_j11_joint",
+    "bh_j21_joint",
+    "bh_j12_joint",
+    "bh_j13_joint",
+    "bh_j22_joint",
+    "bh_j23_joint",
+    "bh_j32_joint",
+    "bh_j33_joint",
+)
 BARRETT_HAND_COUPLING = (
     (1.0, 0.0, 0.0, 0.0),
     (1.0, 0.0, 0.0, 0.0),
@@ -32,32 +40,59 @@ BARRETT_HAND_COUPLING = (
 HOME_ARM = (0.0, 0.9, 0.0, 1.9, 0.0, 0.35, 0.0)
 
 
-def herb_config(urdf: str | Path | None = None, joint_map: Mapping[str, str] | None = None,
-                link_map: Mapping[str, str] | None = None, base_pose: Pose | None = None) -> RobotConfig:
+def herb_config(
+    urdf: str | Path | None = None,
+    joint_map: Mapping[str, str] | None = None,
+    link_map: Mapping[str, str] | None = None,
+    base_pose: Pose | None = None,
+) -> RobotConfig:
     arms, hands, home = [], [], {}
     for s, side in (("l", "left"), ("r", "right")):
         k, d = gains_from_effort(WAM_EFFORT, 100.0, 10.0)
         joints = tuple(f"{s}_wam_j{i}" for i in range(1, 8))
-        arms.append(ArmConfig(name=f"{side}_arm", joints=joints, base_link=f"{s}_wam_base_link",
-                              tcp_link=f"{s}_bh_tcp", stiffness=k, damping=d))
+        arms.append(
+            ArmConfig(
+                name=f"{side}_arm",
+                joints=joints,
+                base_link=f"{s}_wam_base_link",
+                tcp_link=f"{s}_bh_tcp",
+                stiffness=k,
+                damping=d,
+            )
+        )
         hj = tuple(f"{s}_{j}" for j in HAND_JOINTS)
         finger_links = tuple(f"{s}_bh_finger_{f}{n}_link" for f in "123" for n in "23")
-        hands.append(GripperConfig(
-            name=f"{side}_hand", joints=hj, actuators=("spread", "f1", "f2", "f3"),
-            coupling=BARRETT_HAND_COUPLING, open=(0.0, 0.0, 0.0, 0.0),
-            closed=(0.0, BH_PROX[1], BH_PROX[1], BH_PROX[1]), grasp_actuators=("f1", "f2", "f3"),
-            # the spread's worm drive is not backdrivable: a stiff, strong drive stands in for it
-            stiffness=(100.0, 100.0) + (10.0, 10.0) * 3, damping=(2.0, 2.0) + (0.2, 0.2) * 3,
-            force_limit=(10.0, 10.0) + (2.0, 2.0) * 3, finger_links=finger_links,
-            tcp_link=f"{s}_bh_tcp", kind="multifinger",
-            follow=tuple((f"{s}_bh_j{f}3_joint", f"{s}_bh_j{f}2_joint", BH_COUPLING) for f in "123"),
-        ))
+        hands.append(
+            GripperConfig(
+                name=f"{side}_hand",
+                joints=hj,
+                actuators=("spread", "f1", "f2", "f3"),
+                coupling=BARRETT_HAND_COUPLING,
+                open=(0.0, 0.0, 0.0, 0.0),
+                closed=(0.0, BH_PROX[1], BH_PROX[1], BH_PROX[1]),
+                grasp_actuators=("f1", "f2", "f3"),
+                # the spread's worm drive is not backdrivable: a stiff, strong drive stands in for it
+                stiffness=(100.0, 100.0) + (10.0, 10.0) * 3,
+                damping=(2.0, 2.0) + (0.2, 0.2) * 3,
+                force_limit=(10.0, 10.0) + (2.0, 2.0) * 3,
+                finger_links=finger_links,
+                tcp_link=f"{s}_bh_tcp",
+                kind="multifinger",
+                follow=tuple(
+                    (f"{s}_bh_j{f}3_joint", f"{s}_bh_j{f}2_joint", BH_COUPLING) for f in "123"
+                ),
+            )
+        )
         sign = 1.0 if s == "l" else -1.0
         for i, v in enumerate(HOME_ARM):
             home[joints[i]] = sign * v if i in (0, 2, 4, 6) else v
     cfg = RobotConfig(
-        name="herb", urdf=robots_dir() / "herb" / "herb.urdf", arms=tuple(arms), grippers=tuple(hands),
-        home=home, base_pose=base_pose or Pose(),
+        name="herb",
+        urdf=robots_dir() / "herb" / "herb.urdf",
+        arms=tuple(arms),
+        grippers=tuple(hands),
+        home=home,
+        base_pose=base_pose or Pose(),
         summary="CMU HERB: two Barrett WAM 7-DOF arms with BarrettHand BH8-280 (base fixed)",
         sources=("Barrett WAM manual DH parameters", "BarrettHand BH8-280 kinematics"),
     )
@@ -66,6 +101,10 @@ def herb_config(urdf: str | Path | None = None, joint_map: Mapping[str, str] | N
     return cfg
 
 
-def make_herb(urdf: str | Path | None = None, joint_map: Mapping[str, str] | None = None,
-              link_map: Mapping[str, str] | None = None, base_pose: Pose | None = None) -> Robot:
+def make_herb(
+    urdf: str | Path | None = None,
+    joint_map: Mapping[str, str] | None = None,
+    link_map: Mapping[str, str] | None = None,
+    base_pose: Pose | None = None,
+) -> Robot:
     return Robot(herb_config(urdf, joint_map, link_map, base_pose))

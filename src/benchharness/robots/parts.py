@@ -9,8 +9,9 @@ itself is PD targets and backend steps.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -39,7 +40,9 @@ class MotionResult:
     pos_error: float  #: m, tool frame vs target (backend pose) after settling; nan for joint goals
     rot_error: float  #: rad, same
     peak_velocity_ratio: float  #: max over joints of planned peak speed / URDF velocity limit
-    measured_velocity_ratio: float = float("nan")  #: max over joints and control ticks of measured speed / limit
+    measured_velocity_ratio: float = float(
+        "nan"
+    )  #: max over joints and control ticks of measured speed / limit
 
     @property
     def success(self) -> bool:
@@ -58,7 +61,7 @@ class GraspResult:
 class RobotArm:
     """A serial chain ending in a tool frame: an arm, or one finger of a dexterous hand."""
 
-    def __init__(self, config: ArmConfig, robot: "Robot") -> None:
+    def __init__(self, config: ArmConfig, robot: Robot) -> None:
         self.config = config
         self.robot = robot
         self._chain: KinematicChain | None = None
@@ -199,11 +202,19 @@ class RobotArm:
                     origin = ET.SubElement(j, "origin")
                 rpy = [float(x) for x in (origin.get("rpy") or "0 0 0").split()]
                 axis_el = j.find("axis")
-                axis = np.array([float(x) for x in (axis_el.get("xyz") if axis_el is not None else "1 0 0").split()])
-                r = Rotation.from_euler("xyz", rpy) * Rotation.from_rotvec(np.pi * axis / np.linalg.norm(axis))
+                axis = np.array(
+                    [
+                        float(x)
+                        for x in (axis_el.get("xyz") if axis_el is not None else "1 0 0").split()
+                    ]
+                )
+                r = Rotation.from_euler("xyz", rpy) * Rotation.from_rotvec(
+                    np.pi * axis / np.linalg.norm(axis)
+                )
                 origin.set("rpy", " ".join(repr(float(x)) for x in r.as_euler("xyz")))
-            cache[turned] = KinematicChain(ET.tostring(root, encoding="unicode"), self.config.base_link,
-                                           self.config.tcp_link)
+            cache[turned] = KinematicChain(
+                ET.tostring(root, encoding="unicode"), self.config.base_link, self.config.tcp_link
+            )
         return cache[turned]
 
     def _ik_position(self, targets, seed_q, generator, seed, cfg) -> IKResult:
@@ -218,7 +229,11 @@ class RobotArm:
         b = t.shape[0]
         best_q = np.zeros((b, self.chain.dof))
         best_e = np.full(b, np.inf)
-        starts = [None] if seed_q is None else [np.broadcast_to(np.asarray(seed_q, float), (b, self.chain.dof))]
+        starts = (
+            [None]
+            if seed_q is None
+            else [np.broadcast_to(np.asarray(seed_q, float), (b, self.chain.dof))]
+        )
         starts += [self.chain.sample(b, gen) for _ in range(max(cfg.num_retries, 1))]
         for q in starts:
             q = self.chain.sample(b, gen) if q is None else np.array(q, dtype=float)
@@ -271,14 +286,24 @@ class RobotArm:
         local = (base.inv() * target).as_matrix()
         q_now = self.positions() if seed_q is None else np.asarray(seed_q, dtype=float)
         res = self.ik(local[None], seed_q=q_now, generator=generator, seed=seed)
-        motion = self.move_to_joints(res.q[0], duration=duration, velocity_scale=velocity_scale, settle=settle)
+        motion = self.move_to_joints(
+            res.q[0], duration=duration, velocity_scale=velocity_scale, settle=settle
+        )
         reached = self.tcp_pose()
         dp, dr = pose_error(reached.as_matrix(), target.as_matrix())
         if self.config.position_only:
             dr = np.array([np.nan])
-        return MotionResult(bool(res.success[0]), motion.q_goal, motion.duration, motion.max_tracking_error,
-                            motion.final_joint_error, float(dp[0]), float(dr[0]), motion.peak_velocity_ratio,
-                            motion.measured_velocity_ratio)
+        return MotionResult(
+            bool(res.success[0]),
+            motion.q_goal,
+            motion.duration,
+            motion.max_tracking_error,
+            motion.final_joint_error,
+            float(dp[0]),
+            float(dr[0]),
+            motion.peak_velocity_ratio,
+            motion.measured_velocity_ratio,
+        )
 
     def move_to_joints(
         self,
@@ -292,14 +317,22 @@ class RobotArm:
         q_goal = np.clip(np.asarray(q_goal, dtype=float), self.lower, self.upper)
         q0 = self.positions()
         traj = QuinticTrajectory.plan(
-            q0, q_goal, self.max_velocity,
+            q0,
+            q_goal,
+            self.max_velocity,
             velocity_scale=self.config.velocity_scale if velocity_scale is None else velocity_scale,
             duration=duration,
         )
         track = self.robot.track(self.joints, traj, settle=settle)
         return MotionResult(
-            True, q_goal, traj.duration, track["max_tracking_error"], track["final_error"],
-            float("nan"), float("nan"), float(np.max(traj.peak_velocity() / self.max_velocity)) if q0.size else 0.0,
+            True,
+            q_goal,
+            traj.duration,
+            track["max_tracking_error"],
+            track["final_error"],
+            float("nan"),
+            float("nan"),
+            float(np.max(traj.peak_velocity() / self.max_velocity)) if q0.size else 0.0,
             track["measured_velocity_ratio"],
         )
 
@@ -307,7 +340,7 @@ class RobotArm:
 class Gripper:
     """A parallel gripper or multi-fingered hand: coupled finger joints, opened and closed with a force cap."""
 
-    def __init__(self, config: GripperConfig, robot: "Robot") -> None:
+    def __init__(self, config: GripperConfig, robot: Robot) -> None:
         self.config = config
         self.robot = robot
         self.coupling = np.asarray(config.coupling, dtype=float)
@@ -326,7 +359,9 @@ class Gripper:
     def joints(self) -> tuple[str, ...]:
         return self.config.joints
 
-    def set_command(self, u: Sequence[float], force_limit: float | Sequence[float] | None = None) -> None:
+    def set_command(
+        self, u: Sequence[float], force_limit: float | Sequence[float] | None = None
+    ) -> None:
         """Drive the joints towards the coupled targets of actuator values ``u``."""
         self.command = np.asarray(u, dtype=float)
         q = np.clip(self.config.joint_targets(self.command), self.lower, self.upper)
@@ -340,8 +375,12 @@ class Gripper:
                 q = q.copy()
                 q[i] = np.clip(ratio * pos[k], self.lower[i], self.upper[i])
         self.robot.backend.set_joint_targets(
-            self.robot.body, q, np.zeros(len(q)), joints=list(self.joints),
-            stiffness=list(self.config.stiffness), damping=list(self.config.damping),
+            self.robot.body,
+            q,
+            np.zeros(len(q)),
+            joints=list(self.joints),
+            stiffness=list(self.config.stiffness),
+            damping=list(self.config.damping),
             force_limit=self._force.tolist(),
         )
 
@@ -355,14 +394,25 @@ class Gripper:
         for fj, lj, ratio in self.config.follow:
             i, k = self.joints.index(fj), self.joints.index(lj)
             stalled = abs(vel[k]) < 0.05 and abs(self._targets[k] - pos[k]) > 0.02
-            target = self._targets[i] if stalled else np.clip(ratio * pos[k], self.lower[i], self.upper[i])
+            target = (
+                self._targets[i]
+                if stalled
+                else np.clip(ratio * pos[k], self.lower[i], self.upper[i])
+            )
             names.append(fj)
             q.append(float(target))
             k_.append(self.config.stiffness[i])
             d_.append(self.config.damping[i])
             f_.append(float(self._force[i]))
-        self.robot.backend.set_joint_targets(self.robot.body, q, [0.0] * len(q), joints=names,
-                                             stiffness=k_, damping=d_, force_limit=f_)
+        self.robot.backend.set_joint_targets(
+            self.robot.body,
+            q,
+            [0.0] * len(q),
+            joints=names,
+            stiffness=k_,
+            damping=d_,
+            force_limit=f_,
+        )
 
     def open(self, *, wait: float = 0.5) -> GraspResult:
         self.set_command(self.config.open)
@@ -400,14 +450,18 @@ class Gripper:
         measured mid-width makes each an unsaturated spring pressing with
         ``F`` that pushes the object back to the middle if it moves.
         """
-        f = np.broadcast_to(np.asarray(self.config.force_limit if force_limit is None else force_limit, float),
-                            (len(self.joints),))
+        f = np.broadcast_to(
+            np.asarray(self.config.force_limit if force_limit is None else force_limit, float),
+            (len(self.joints),),
+        )
         k = np.asarray(self.config.stiffness, dtype=float)
         q = first.joint_positions
         u = np.array([float(np.mean(q)) - float(np.mean(f / k))])
         self.set_command(u, 1.5 * f)
         res = self._wait(obj, 0.5, u)
-        return GraspResult(res.contact, False, res.actuators, res.joint_positions, first.time + res.time)
+        return GraspResult(
+            res.contact, False, res.actuators, res.joint_positions, first.time + res.time
+        )
 
     def _wait(self, obj: BodyId | None, timeout: float, u_target: np.ndarray) -> GraspResult:
         r = self.robot
@@ -424,7 +478,9 @@ class Gripper:
                 break
         q = r.joint_positions(names)
         q_closed = np.clip(self.config.joint_targets(u_target), self.lower, self.upper)
-        closed = bool(np.all(np.abs(q - q_closed) < 0.01 * np.maximum(1.0, np.abs(self.upper - self.lower))))
+        closed = bool(
+            np.all(np.abs(q - q_closed) < 0.01 * np.maximum(1.0, np.abs(self.upper - self.lower)))
+        )
         u_meas = np.linalg.lstsq(self.coupling, q, rcond=None)[0]
         return GraspResult(self.touching(obj), closed, u_meas, q, t)
 

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 from ..geometry import Pose
 from ..paths import robots_dir
@@ -13,16 +13,29 @@ from .robot import Robot
 
 __all__ = ["PR2_FULL_URDF_LINK_MAP", "PR2_FULL_URDF_JOINT_MAP", "pr2_config", "make_pr2"]
 
-ARM_JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "upper_arm_roll_joint", "elbow_flex_joint",
-              "forearm_roll_joint", "wrist_flex_joint", "wrist_roll_joint")
+ARM_JOINTS = (
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "upper_arm_roll_joint",
+    "elbow_flex_joint",
+    "forearm_roll_joint",
+    "wrist_flex_joint",
+    "wrist_roll_joint",
+)
 ARM_EFFORT = (30, 30, 30, 30, 30, 10, 10)  # N m, pr2_description
 
 #: Home (left arm; the right mirrors it): torso 0.1 m up, elbows out, each gripper horizontal and pointing
 #: forward, 0.65 m in front of the base centre, 0.12 m either side of the midline, 0.79 m above the floor
 #: (an IK solution, rounded).
-HOME_ARM = {"shoulder_pan_joint": 0.5, "shoulder_lift_joint": 0.13, "upper_arm_roll_joint": 1.75,
-            "elbow_flex_joint": -1.78, "forearm_roll_joint": -2.93, "wrist_flex_joint": -1.31,
-            "wrist_roll_joint": 1.41}
+HOME_ARM = {
+    "shoulder_pan_joint": 0.5,
+    "shoulder_lift_joint": 0.13,
+    "upper_arm_roll_joint": 1.75,
+    "elbow_flex_joint": -1.78,
+    "forearm_roll_joint": -2.93,
+    "wrist_flex_joint": -1.31,
+    "wrist_roll_joint": 1.41,
+}
 
 #: Our names -> names in the Willow Garage ``pr2_description`` URDF. The real gripper is one
 #: ``l_gripper_joint`` with mimic fingers, which our two-prismatic-finger gripper part cannot drive,
@@ -30,29 +43,57 @@ HOME_ARM = {"shoulder_pan_joint": 0.5, "shoulder_lift_joint": 0.13, "upper_arm_r
 PR2_FULL_URDF_JOINT_MAP: Mapping[str, str] = {
     f"{s}_gripper_{f}_finger_joint": "" for s in "lr" for f in "lr"
 }
-PR2_FULL_URDF_LINK_MAP: Mapping[str, str] = {"l_gripper_tcp": "l_gripper_tool_frame", "r_gripper_tcp": "r_gripper_tool_frame"}
+PR2_FULL_URDF_LINK_MAP: Mapping[str, str] = {
+    "l_gripper_tcp": "l_gripper_tool_frame",
+    "r_gripper_tcp": "r_gripper_tool_frame",
+}
 
 
-def pr2_config(urdf: str | Path | None = None, joint_map: Mapping[str, str] | None = None,
-               link_map: Mapping[str, str] | None = None, base_pose: Pose | None = None) -> RobotConfig:
+def pr2_config(
+    urdf: str | Path | None = None,
+    joint_map: Mapping[str, str] | None = None,
+    link_map: Mapping[str, str] | None = None,
+    base_pose: Pose | None = None,
+) -> RobotConfig:
     arms, grippers, home = [], [], {"torso_lift_joint": 0.1}
     for s, side in (("l", "left"), ("r", "right")):
         k, d = gains_from_effort(ARM_EFFORT, 100.0, 10.0)
-        arms.append(ArmConfig(
-            name=f"{side}_arm", joints=tuple(f"{s}_{j}" for j in ARM_JOINTS), base_link="torso_lift_link",
-            tcp_link=f"{s}_gripper_tcp", stiffness=k, damping=d, gravity_carried=True,
-        ))
-        grippers.append(GripperConfig(
-            name=f"{side}_gripper", joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
-            actuators=("half_opening",), coupling=((1.0,), (1.0,)),
-            open=(FINGER_TRAVEL,), closed=(0.0,), grasp_actuators=("half_opening",),
-            stiffness=(2000.0, 2000.0), damping=(40.0, 40.0), force_limit=(20.0, 20.0),
-            finger_links=(f"{s}_gripper_l_finger_link", f"{s}_gripper_r_finger_link"),
-            tcp_link=f"{s}_gripper_tcp", kind="parallel",
-        ))
+        arms.append(
+            ArmConfig(
+                name=f"{side}_arm",
+                joints=tuple(f"{s}_{j}" for j in ARM_JOINTS),
+                base_link="torso_lift_link",
+                tcp_link=f"{s}_gripper_tcp",
+                stiffness=k,
+                damping=d,
+                gravity_carried=True,
+            )
+        )
+        grippers.append(
+            GripperConfig(
+                name=f"{side}_gripper",
+                joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
+                actuators=("half_opening",),
+                coupling=((1.0,), (1.0,)),
+                open=(FINGER_TRAVEL,),
+                closed=(0.0,),
+                grasp_actuators=("half_opening",),
+                stiffness=(2000.0, 2000.0),
+                damping=(40.0, 40.0),
+                force_limit=(20.0, 20.0),
+                finger_links=(f"{s}_gripper_l_finger_link", f"{s}_gripper_r_finger_link"),
+                tcp_link=f"{s}_gripper_tcp",
+                kind="parallel",
+            )
+        )
         sign = 1.0 if s == "l" else -1.0
         for j, v in HOME_ARM.items():
-            mirrored = j in ("shoulder_pan_joint", "upper_arm_roll_joint", "forearm_roll_joint", "wrist_roll_joint")
+            mirrored = j in (
+                "shoulder_pan_joint",
+                "upper_arm_roll_joint",
+                "forearm_roll_joint",
+                "wrist_roll_joint",
+            )
             home[f"{s}_{j}"] = sign * v if mirrored else v
     cfg = RobotConfig(
         name="pr2",
@@ -71,7 +112,11 @@ def pr2_config(urdf: str | Path | None = None, joint_map: Mapping[str, str] | No
     return cfg
 
 
-def make_pr2(urdf: str | Path | None = None, joint_map: Mapping[str, str] | None = None,
-             link_map: Mapping[str, str] | None = None, base_pose: Pose | None = None) -> Robot:
+def make_pr2(
+    urdf: str | Path | None = None,
+    joint_map: Mapping[str, str] | None = None,
+    link_map: Mapping[str, str] | None = None,
+    base_pose: Pose | None = None,
+) -> Robot:
     """Plugin factory: our PR2, or the PR2 parts on ``urdf`` with names mapped (see module maps)."""
     return Robot(pr2_config(urdf, joint_map, link_map, base_pose))

@@ -23,8 +23,14 @@ from .robot import Robot
 
 __all__ = ["STAGE_JOINTS", "pr2_gripper_config", "make_pr2_gripper", "stage_joints_for", "MOUNT"]
 
-STAGE_JOINTS = ("stage_x_joint", "stage_y_joint", "stage_z_joint", "wrist_yaw_joint", "wrist_pitch_joint",
-                "wrist_roll_joint")
+STAGE_JOINTS = (
+    "stage_x_joint",
+    "stage_y_joint",
+    "stage_z_joint",
+    "wrist_yaw_joint",
+    "wrist_pitch_joint",
+    "wrist_roll_joint",
+)
 #: Tool frame at zero wrist angles, relative to the wrist frame.
 MOUNT = Rotation.from_euler("xyz", MOUNT_RPY)
 
@@ -57,17 +63,28 @@ def pr2_gripper_config(base_pose: Pose | None = None, grip_force: float = 20.0) 
     s = SIDE
     k_lin, k_rot = 100.0 * STAGE_EFFORT, 100.0 * WRIST_EFFORT
     stage = ArmConfig(
-        name="stage", joints=STAGE_JOINTS, base_link="stage_base", tcp_link=f"{s}_gripper_tcp",
-        stiffness=(k_lin,) * 3 + (k_rot,) * 3, damping=(0.1 * k_lin,) * 3 + (0.1 * k_rot,) * 3,
+        name="stage",
+        joints=STAGE_JOINTS,
+        base_link="stage_base",
+        tcp_link=f"{s}_gripper_tcp",
+        stiffness=(k_lin,) * 3 + (k_rot,) * 3,
+        damping=(0.1 * k_lin,) * 3 + (0.1 * k_rot,) * 3,
         velocity_scale=0.5,
     )
     grip = GripperConfig(
-        name="gripper", joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
-        actuators=("half_opening",), coupling=((1.0,), (1.0,)), open=(FINGER_TRAVEL,), closed=(0.0,),
-        grasp_actuators=("half_opening",), stiffness=(2000.0, 2000.0), damping=(40.0, 40.0),
+        name="gripper",
+        joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
+        actuators=("half_opening",),
+        coupling=((1.0,), (1.0,)),
+        open=(FINGER_TRAVEL,),
+        closed=(0.0,),
+        grasp_actuators=("half_opening",),
+        stiffness=(2000.0, 2000.0),
+        damping=(40.0, 40.0),
         force_limit=(grip_force, grip_force),
         finger_links=(f"{s}_gripper_l_finger_link", f"{s}_gripper_r_finger_link"),
-        tcp_link=f"{s}_gripper_tcp", kind="parallel",
+        tcp_link=f"{s}_gripper_tcp",
+        kind="parallel",
     )
     return RobotConfig(
         name="pr2-gripper",
@@ -81,7 +98,9 @@ def pr2_gripper_config(base_pose: Pose | None = None, grip_force: float = 20.0) 
     )
 
 
-def make_pr2_gripper(base_pose: Pose | None = None, grip_force: float = 20.0, urdf: str | Path | None = None) -> Robot:
+def make_pr2_gripper(
+    base_pose: Pose | None = None, grip_force: float = 20.0, urdf: str | Path | None = None
+) -> Robot:
     """Plugin factory for ``pr2-gripper``; ``urdf`` may point at another file with the same names."""
     cfg = pr2_gripper_config(base_pose, grip_force)
     if urdf is not None:

@@ -9,8 +9,8 @@ or opens a hand.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -45,7 +45,9 @@ class Robot:
         self.link_names: list[str] = read_links(self.urdf_path)
         missing = [j for g in config.groups().values() for j in g if j not in self.urdf_joints]
         if missing:
-            raise ValueError(f"robot {config.name!r}: joints {missing} are not movable joints of {self.urdf_path}")
+            raise ValueError(
+                f"robot {config.name!r}: joints {missing} are not movable joints of {self.urdf_path}"
+            )
         self.arms: dict[str, RobotArm] = {a.name: RobotArm(a, self) for a in config.arms}
         self.grippers: dict[str, Gripper] = {g.name: Gripper(g, self) for g in config.grippers}
         self._gains = self._collect_gains()
@@ -122,14 +124,20 @@ class Robot:
         return g
 
     # -- simulation ------------------------------------------------------------------
-    def spawn(self, backend: Backend, base_pose: Pose | None = None, *, q: Sequence[float] | None = None) -> BodyId:
+    def spawn(
+        self, backend: Backend, base_pose: Pose | None = None, *, q: Sequence[float] | None = None
+    ) -> BodyId:
         """Load the robot into ``backend`` at ``base_pose`` (default: the config's), in home pose, holding it."""
         pose = base_pose or self.config.base_pose
         self.backend = backend
-        self.body = backend.load_urdf(self.urdf_path, pose, fixed_base=self.config.fixed_base, name=self.name)
+        self.body = backend.load_urdf(
+            self.urdf_path, pose, fixed_base=self.config.fixed_base, name=self.name
+        )
         names = backend.joint_names(self.body)
         if names != self.joint_names:
-            raise RuntimeError(f"backend joint order {names} differs from the URDF's {self.joint_names}")
+            raise RuntimeError(
+                f"backend joint order {names} differs from the URDF's {self.joint_names}"
+            )
         self._base_rot = pose.rotation.as_matrix()
         self._gravity = None  # built on first use, only for backends without gravity_torques
         self._gcache = None
@@ -182,7 +190,18 @@ class Robot:
             sel = np.array([i for i, j in enumerate(joints) if j in gj], dtype=int)
             carried = {j for a in self.config.arms if a.gravity_carried for j in a.joints}
             carried_mask = np.array([j in carried for j in joints], dtype=bool)
-            plan = (list(joints), idx, k, d, k.tolist(), d.tolist(), eff, sel, idx[sel], carried_mask)
+            plan = (
+                list(joints),
+                idx,
+                k,
+                d,
+                k.tolist(),
+                d.tolist(),
+                eff,
+                sel,
+                idx[sel],
+                carried_mask,
+            )
             self._plans[joints] = plan
         return plan
 
@@ -198,8 +217,13 @@ class Robot:
             tau[sel] = self._gravity_all()[gidx]
         limit = eff + np.where(carried, np.abs(tau), 0.0)
         be.set_joint_targets(
-            self.body, q + tau / np.maximum(k, 1e-9), np.zeros(len(names)) if qd is None else qd,
-            joints=names, stiffness=k_list, damping=d_list, force_limit=limit.tolist(),
+            self.body,
+            q + tau / np.maximum(k, 1e-9),
+            np.zeros(len(names)) if qd is None else qd,
+            joints=names,
+            stiffness=k_list,
+            damping=d_list,
+            force_limit=limit.tolist(),
         )
 
     def _gravity_torques(self, joints: list[str]) -> np.ndarray:
@@ -230,7 +254,8 @@ class Robot:
                 names = self._gravity_joints()
                 tau = np.zeros(self.dof)
                 tau[[self.joint_names.index(j) for j in names]] = self._gravity.torques(
-                    dict(zip(self.joint_names, q)), names, self._base_rot)
+                    dict(zip(self.joint_names, q)), names, self._base_rot
+                )
             self._gcache = (q.copy(), tau)
         return self._gcache[1]
 
@@ -294,7 +319,11 @@ class Robot:
             self._tick()
         self.settle(settle) if settle > 0 else None
         final = float(np.max(np.abs(self.joint_positions()[idx] - traj.q1)))
-        return {"max_tracking_error": max_err, "final_error": final, "measured_velocity_ratio": peak_ratio}
+        return {
+            "max_tracking_error": max_err,
+            "final_error": final,
+            "measured_velocity_ratio": peak_ratio,
+        }
 
     def tcp_poses(self) -> dict[str, Pose]:
         be = self._require()

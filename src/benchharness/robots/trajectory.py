@@ -36,7 +36,7 @@ class QuinticTrajectory:
         velocity_scale: float = 1.0,
         min_duration: float = 0.05,
         duration: float | None = None,
-    ) -> "QuinticTrajectory":
+    ) -> QuinticTrajectory:
         q0 = np.asarray(q0, dtype=float)
         q1 = np.asarray(q1, dtype=float)
         vmax = np.asarray(max_velocity, dtype=float) * velocity_scale

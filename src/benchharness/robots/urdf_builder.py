@@ -15,8 +15,9 @@ so the generated file says where each number came from.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal, Sequence
+from typing import Literal
 from xml.sax.saxutils import escape
 
 import numpy as np

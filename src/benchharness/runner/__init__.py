@@ -15,7 +15,17 @@ See docs/runner.md. Importing this package imports no physics engine.
 """
 
 from .causes import FailureCause, TrialStatus
-from .contract import InhandItem, RubiksItem, SensorSlot, Strategy, TimeBudget, TrialContext, TrialItem, TrialOutcome, TrialTimeout
+from .contract import (
+    InhandItem,
+    RubiksItem,
+    SensorSlot,
+    Strategy,
+    TimeBudget,
+    TrialContext,
+    TrialItem,
+    TrialOutcome,
+    TrialTimeout,
+)
 from .recorder import TrialRecorder
 from .records import TrialRecord
 from .spec import RunSpec, code_version, parse_physics

@@ -30,14 +30,16 @@ class FailureCause(str, Enum):
 
     DROPPED = "dropped"  #: the object left the robot's hands / fell (strategy-declared)
     JAMMED = "jammed"  #: a twist or motion could not proceed (strategy-declared)
-    WRONG_STATE = "wrong_state"  #: the validator's expected final state differs from the observed one
+    WRONG_STATE = (
+        "wrong_state"  #: the validator's expected final state differs from the observed one
+    )
     UNREACHABLE = "unreachable"  #: no kinematic solution / target out of reach (strategy-declared)
     TIMEOUT = "timeout"  #: the simulated- or wall-time budget ran out
     SIMULATOR_ERROR = "simulator_error"  #: SimulationError/BackendError, or the worker process died
     STRATEGY_ERROR = "strategy_error"  #: any other exception, or an outcome the runner cannot score
 
     @classmethod
-    def parse(cls, value: "str | FailureCause") -> "FailureCause":
+    def parse(cls, value: str | FailureCause) -> FailureCause:
         if isinstance(value, cls):
             return value
         try:

@@ -16,8 +16,9 @@ whatever the number of workers and whichever trials ran before.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Mapping, Protocol, Sequence, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -194,12 +195,12 @@ class TrialContext:
     item: TrialItem
     trial_index: int
     robot: Any
-    backend: "Backend"
+    backend: Backend
     sensors: Mapping[str, SensorSlot]
     rng: np.random.Generator
     budget: TimeBudget
-    recorder: "TrialRecorder"
-    physics: "PhysicsConfig"
+    recorder: TrialRecorder
+    physics: PhysicsConfig
     run: Mapping[str, Any] = field(default_factory=dict)
     wall_start: float = field(default_factory=time.perf_counter)
     sim_start: float = 0.0
@@ -224,9 +225,13 @@ class TrialContext:
         """
         b = self.budget
         if b.sim_s is not None and self.sim_elapsed > b.sim_s:
-            raise TrialTimeout(f"simulated-time budget of {b.sim_s:g} s spent ({self.sim_elapsed:.3f} s)")
+            raise TrialTimeout(
+                f"simulated-time budget of {b.sim_s:g} s spent ({self.sim_elapsed:.3f} s)"
+            )
         if b.wall_s is not None and self.wall_elapsed > b.wall_s:
-            raise TrialTimeout(f"wall-time budget of {b.wall_s:g} s spent ({self.wall_elapsed:.1f} s)")
+            raise TrialTimeout(
+                f"wall-time budget of {b.wall_s:g} s spent ({self.wall_elapsed:.1f} s)"
+            )
 
 
 @runtime_checkable
@@ -239,5 +244,4 @@ class Strategy(Protocol):
     ``("inhand",)``); the runner refuses other tasks before starting.
     """
 
-    def run_trial(self, ctx: TrialContext) -> TrialOutcome:
-        ...
+    def run_trial(self, ctx: TrialContext) -> TrialOutcome: ...

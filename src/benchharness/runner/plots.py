@@ -9,8 +9,8 @@ move index.
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -30,8 +30,13 @@ def pose_error_series(trials: Sequence[StoredTrial]) -> dict[str, dict[str, np.n
             # table with a belief nobody holds: not an estimation error
             if e.get("pos_err_m") is None or e.get("label") == "release":
                 continue
-            acc[col_of[t.run_key].label].append((int(e["move_index"]), 1000.0 * float(e["pos_err_m"]),
-                                                 float(e.get("rot_err_deg") or np.nan)))
+            acc[col_of[t.run_key].label].append(
+                (
+                    int(e["move_index"]),
+                    1000.0 * float(e["pos_err_m"]),
+                    float(e.get("rot_err_deg") or np.nan),
+                )
+            )
     out = {}
     for label, rows in acc.items():
         a = np.array(rows, float)
@@ -43,8 +48,10 @@ def plot_pose_error(trials: Sequence[StoredTrial], path: str | Path, title: str 
     """Write the PNG (or any format matplotlib knows from the suffix); error if nothing was logged."""
     series = pose_error_series(trials)
     if not series:
-        raise ValueError("no pose estimates in the selected trials' diagnostics "
-                         "(strategies log them with ctx.recorder.pose_estimate)")
+        raise ValueError(
+            "no pose estimates in the selected trials' diagnostics "
+            "(strategies log them with ctx.recorder.pose_estimate)"
+        )
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -64,7 +71,9 @@ def plot_pose_error(trials: Sequence[StoredTrial], path: str | Path, title: str 
     axes[1].set_xlabel("move index")
     axes[1].xaxis.set_major_locator(MaxNLocator(integer=True))  # moves are whole numbers
     axes[0].legend(fontsize="small")
-    axes[0].set_title(title or "cube pose estimate vs true pose (median per move, all logged estimates)")
+    axes[0].set_title(
+        title or "cube pose estimate vs true pose (median per move, all logged estimates)"
+    )
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)

@@ -9,8 +9,9 @@ the simulated time at which they were logged, so plots and a video line up.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -77,7 +78,7 @@ class TrialRecorder:
     first_contact_s: float | None = None
     events: list[dict[str, Any]] = field(default_factory=list)
     estimates: list[PoseEstimate] = field(default_factory=list)
-    watched: list[tuple["BodyId", "BodyId | None"]] = field(default_factory=list)
+    watched: list[tuple[BodyId, BodyId | None]] = field(default_factory=list)
 
     # -- the score's anchor --------------------------------------------------------------
     def contact(self, t: float | None = None) -> None:
@@ -86,19 +87,26 @@ class TrialRecorder:
             self.first_contact_s = float(self.clock() if t is None else t)
             self.events.append({"kind": "first_contact", "t": self.first_contact_s})
 
-    def watch_contact(self, body_a: "BodyId", body_b: "BodyId | None" = None) -> None:
+    def watch_contact(self, body_a: BodyId, body_b: BodyId | None = None) -> None:
         """Let the runner detect first contact: after every step it asks the backend
         for contacts between ``body_a`` (the cube) and ``body_b`` (the robot; ``None``
         = any body) and calls :meth:`contact` at the first one."""
         self.watched.append((body_a, body_b))
 
     # -- diagnostics ------------------------------------------------------------------------
-    def pose_estimate(self, move_index: int, true_pose: Any, estimated_pose: Any, label: str = "regrasp") -> PoseEstimate:
+    def pose_estimate(
+        self, move_index: int, true_pose: Any, estimated_pose: Any, label: str = "regrasp"
+    ) -> PoseEstimate:
         """The cube pose the strategy believes vs the true (simulator) pose, e.g. at a regrasp."""
         pos, rot = pose_errors(true_pose, estimated_pose)
         est = PoseEstimate(
-            int(move_index), float(self.clock()), str(label),
-            tuple(map(float, _pose_array(true_pose))), tuple(map(float, _pose_array(estimated_pose))), pos, rot,
+            int(move_index),
+            float(self.clock()),
+            str(label),
+            tuple(map(float, _pose_array(true_pose))),
+            tuple(map(float, _pose_array(estimated_pose))),
+            pos,
+            rot,
         )
         self.estimates.append(est)
         return est
@@ -107,13 +115,23 @@ class TrialRecorder:
         """A move of the sequence was executed (``data``: e.g. measured layer angles)."""
         self.event("move", move_index=move_index, move=str(move), **data)
 
-    def unintended_rotation(self, move_index: int, expected: str, observed: str, **data: Any) -> None:
+    def unintended_rotation(
+        self, move_index: int, expected: str, observed: str, **data: Any
+    ) -> None:
         """The cube turned differently from the command (dragged middle slab, extra turn)."""
-        self.event("unintended_rotation", move_index=move_index, expected=str(expected), observed=str(observed), **data)
+        self.event(
+            "unintended_rotation",
+            move_index=move_index,
+            expected=str(expected),
+            observed=str(observed),
+            **data,
+        )
 
     def blocked_rotation(self, move_index: int, move: str, reason: str, **data: Any) -> None:
         """A twist could not start or finish (misaligned layer, over-constrained grasp)."""
-        self.event("blocked_rotation", move_index=move_index, move=str(move), reason=str(reason), **data)
+        self.event(
+            "blocked_rotation", move_index=move_index, move=str(move), reason=str(reason), **data
+        )
 
     def event(self, kind: str, **data: Any) -> None:
         """Any other diagnostic; ``data`` must be JSON-serialisable (arrays and Poses are converted)."""
@@ -130,8 +148,13 @@ class TrialRecorder:
             "events": self.events,
             "pose_estimates": [
                 {
-                    "move_index": e.move_index, "t": e.t, "label": e.label, "true": list(e.true),
-                    "estimated": list(e.estimated), "pos_err_m": e.pos_err_m, "rot_err_deg": e.rot_err_deg,
+                    "move_index": e.move_index,
+                    "t": e.t,
+                    "label": e.label,
+                    "true": list(e.true),
+                    "estimated": list(e.estimated),
+                    "pos_err_m": e.pos_err_m,
+                    "rot_err_deg": e.rot_err_deg,
                 }
                 for e in self.estimates
             ],
@@ -139,4 +162,3 @@ class TrialRecorder:
                 k: self.count(k) for k in ("move", "unintended_rotation", "blocked_rotation")
             },
         }
-

@@ -18,8 +18,9 @@ Every number comes from :mod:`benchharness.metrics` (``mean_and_std``,
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -61,8 +62,16 @@ class Column:
 
     @property
     def key(self) -> tuple:
-        return (self.robot, self.strategy, self.sensors, self.backend, self.seed, self.physics_hash,
-                self.options_hash, self.code_version)
+        return (
+            self.robot,
+            self.strategy,
+            self.sensors,
+            self.backend,
+            self.seed,
+            self.physics_hash,
+            self.options_hash,
+            self.code_version,
+        )
 
 
 def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Column]]:
@@ -91,7 +100,11 @@ def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Col
     by_run: dict[str, tuple] = {}
     for t in trials:
         mk = method_key(t)
-        k = (*mk, t.options_hash if mk in split_opt else "", t.code_version if mk in split_code else "")
+        k = (
+            *mk,
+            t.options_hash if mk in split_opt else "",
+            t.code_version if mk in split_code else "",
+        )
         raw.setdefault(k, t)
         if t.code_version not in codes.setdefault(k, []):
             codes[k].append(t.code_version)
@@ -105,7 +118,9 @@ def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Col
             if (f == "options_hash" and not k[6]) or (f == "code_version" and not k[7]):
                 continue
             if any(getattr(raw[o], f) != getattr(t, f) for o in same):
-                extra.append(f"seed {t.seed}" if f == "seed" else f"{f.split('_')[0]} {getattr(t, f)}")
+                extra.append(
+                    f"seed {t.seed}" if f == "seed" else f"{f.split('_')[0]} {getattr(t, f)}"
+                )
         labels[k] = base[k] + (" " + ", ".join(extra) if extra else "")
     cols = {k: Column(labels[k], *k[:7], ", ".join(codes[k])) for k in raw}
     return list(cols.values()), {run: cols[k] for run, k in by_run.items()}
@@ -135,8 +150,17 @@ def rubiks_cell(trials: Sequence[StoredTrial], required: int) -> RubiksCell:
     causes = Counter(t.failure_cause.value for t in trials if t.failure_cause is not None)
     sims = [t.sim_s for t in trials if t.sim_s is not None]
     walls = [t.wall_s for t in trials if t.wall_s is not None]
-    return RubiksCell(required, len(indices), len(ok), completed, mean, std, dict(causes),
-                      float(np.mean(sims)) if sims else None, float(np.mean(walls)) if walls else None)
+    return RubiksCell(
+        required,
+        len(indices),
+        len(ok),
+        completed,
+        mean,
+        std,
+        dict(causes),
+        float(np.mean(sims)) if sims else None,
+        float(np.mean(walls)) if walls else None,
+    )
 
 
 def format_cell(cell: RubiksCell | None) -> str:
@@ -173,7 +197,11 @@ class RubiksTable:
         for tier in self.tiers:
             row: dict[str, Any] = {"tier": tier, "published": {}, "ours": {}}
             for b in tiers[tier].baselines:
-                row["published"][b.label] = {"completed": b.completed, "mean_s": b.mean_s, "std_s": b.std_s}
+                row["published"][b.label] = {
+                    "completed": b.completed,
+                    "mean_s": b.mean_s,
+                    "std_s": b.std_s,
+                }
             for c in self.columns:
                 cell = self.cells.get((tier, c.label))
                 if cell is not None:
@@ -248,31 +276,54 @@ def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
     if scored:
         a = _inhand_arrays(scored)
-        s = score_trials(a["initial"], a["desired"], a["reached"], setup=a["setup"], dropped=a["dropped"],
-                         plan_time_s=a["plan_time_s"], exec_time_s=a["exec_time_s"])
+        s = score_trials(
+            a["initial"],
+            a["desired"],
+            a["reached"],
+            setup=a["setup"],
+            dropped=a["dropped"],
+            plan_time_s=a["plan_time_s"],
+            exec_time_s=a["exec_time_s"],
+        )
         labels = np.array([col_of[t.run_key].label for t in scored], dtype=object)
         for g in summarize_scores(s, {"method": labels}, ("method",), a["dropped"]):
             label = g.key[0]
-            rows.append({
-                "source": "ours", "method": label, "trials": g.n_trials, "discarded": g.n_discarded,
-                "drops_percent": g.drops_percent,
-                "err_pos_cm": _median(g.stats, "err_pos", 100.0),
-                "err_pos_percent": _median(g.stats, "err_pos_percent"),
-                "err_or_percent": _median(g.stats, "err_or_percent"),
-                "failed_other": sum(col_of[t.run_key].label == label for t in other),
-            })
+            rows.append(
+                {
+                    "source": "ours",
+                    "method": label,
+                    "trials": g.n_trials,
+                    "discarded": g.n_discarded,
+                    "drops_percent": g.drops_percent,
+                    "err_pos_cm": _median(g.stats, "err_pos", 100.0),
+                    "err_pos_percent": _median(g.stats, "err_pos_percent"),
+                    "err_or_percent": _median(g.stats, "err_or_percent"),
+                    "failed_other": sum(col_of[t.run_key].label == label for t in other),
+                }
+            )
     for label in {col_of[t.run_key].label for t in other} - {r["method"] for r in rows}:
-        rows.append({"source": "ours", "method": label, "trials": 0, "discarded": 0, "drops_percent": None,
-                     "err_pos_cm": None, "err_pos_percent": None, "err_or_percent": None,
-                     "failed_other": sum(col_of[t.run_key].label == label for t in other)})
+        rows.append(
+            {
+                "source": "ours",
+                "method": label,
+                "trials": 0,
+                "discarded": 0,
+                "drops_percent": None,
+                "err_pos_cm": None,
+                "err_pos_percent": None,
+                "err_or_percent": None,
+                "failed_other": sum(col_of[t.run_key].label == label for t in other),
+            }
+        )
     for method, v in TABLE_II.items():
         rows.append({"source": "paper", "method": method, **dict(v)})
     return rows
 
 
-def inhand_table3(trials: Sequence[StoredTrial],
-                  contact_scorer: Callable[[StoredTrial], Mapping[str, float] | None] | None = None,
-                  ) -> list[dict[str, Any]]:
+def inhand_table3(
+    trials: Sequence[StoredTrial],
+    contact_scorer: Callable[[StoredTrial], Mapping[str, float] | None] | None = None,
+) -> list[dict[str, Any]]:
     """Per method: per task, median metrics over its trials, with the paper's DMG figures by object.
 
     Only Level II/III trials: the paper's per-task table is for contact tasks;
@@ -291,8 +342,15 @@ def inhand_table3(trials: Sequence[StoredTrial],
         return []
     columns, col_of = _columns(scored)
     a = _inhand_arrays(scored)
-    s = score_trials(a["initial"], a["desired"], a["reached"], setup=a["setup"], dropped=a["dropped"],
-                     plan_time_s=a["plan_time_s"], exec_time_s=a["exec_time_s"])
+    s = score_trials(
+        a["initial"],
+        a["desired"],
+        a["reached"],
+        setup=a["setup"],
+        dropped=a["dropped"],
+        plan_time_s=a["plan_time_s"],
+        exec_time_s=a["exec_time_s"],
+    )
     cols = {
         "method": np.array([col_of[t.run_key].label for t in scored], dtype=object),
         "task_id": np.array([t.outcome.get("task_id", "") for t in scored], dtype=object),
@@ -306,11 +364,17 @@ def inhand_table3(trials: Sequence[StoredTrial],
                 g_ = contact_scorer(t)
                 if g_:
                     contact[i] = g_
-    graph = np.array([float((t.outcome.get("extra") or {}).get("dmg_time_s", np.nan)) for t in scored])
+    graph = np.array(
+        [float((t.outcome.get("extra") or {}).get("dmg_time_s", np.nan)) for t in scored]
+    )
     for g in summarize_scores(s, cols, ("method", "task_id"), a["dropped"]):
         method, task_id = g.key
         obj = objects.get(task_id, "")
-        rows_ = [i for i in range(len(scored)) if cols["method"][i] == method and cols["task_id"][i] == task_id]
+        rows_ = [
+            i
+            for i in range(len(scored))
+            if cols["method"][i] == method and cols["task_id"][i] == task_id
+        ]
 
         def med(values: list[float], scale: float = 1.0) -> float | None:
             v = [x for x in values if x is not None and np.isfinite(x)]
@@ -320,16 +384,25 @@ def inhand_table3(trials: Sequence[StoredTrial],
             "err_pos_cm": _median(g.stats, "err_pos", 100.0),
             "err_pos_percent": _median(g.stats, "err_pos_percent"),
             "err_or_percent": _median(g.stats, "err_or_percent"),
-            **{f"{k}_cm": med([contact[i][k] for i in rows_ if i in contact], 100.0) for k in ("g_euc", "g_geo", "g_min")},
+            **{
+                f"{k}_cm": med([contact[i][k] for i in rows_ if i in contact], 100.0)
+                for k in ("g_euc", "g_geo", "g_min")
+            },
             "graph_time_s": med([graph[i] for i in rows_]),
             "plan_time_s": _median(g.stats, "plan_time_s"),
         }
-        out.append({
-            "method": method, "task_id": task_id, "object": obj, "trials": g.n_trials,
-            "drops_percent": g.drops_percent, "ours": ours, "paper": dict(TABLE_III.get(obj, {})),
-        })
+        out.append(
+            {
+                "method": method,
+                "task_id": task_id,
+                "object": obj,
+                "trials": g.n_trials,
+                "drops_percent": g.drops_percent,
+                "ours": ours,
+                "paper": dict(TABLE_III.get(obj, {})),
+            }
+        )
     return out
-
 
 
 def inhand_box_plot(trials: Sequence[StoredTrial], path, *, title: str | None = None):
@@ -344,21 +417,34 @@ def inhand_box_plot(trials: Sequence[StoredTrial], path, *, title: str | None = 
 
     scored, _ = _scorable(trials)
     if not scored:
-        raise ValueError("no in-hand trials with a reached pose in the selection (benchharness run --task inhand-...)")
+        raise ValueError(
+            "no in-hand trials with a reached pose in the selection (benchharness run --task inhand-...)"
+        )
     _, col_of = _columns(scored)
     a = _inhand_arrays(scored)
-    s = score_trials(a["initial"], a["desired"], a["reached"], setup=a["setup"], dropped=a["dropped"],
-                     plan_time_s=a["plan_time_s"], exec_time_s=a["exec_time_s"])
+    s = score_trials(
+        a["initial"],
+        a["desired"],
+        a["reached"],
+        setup=a["setup"],
+        dropped=a["dropped"],
+        plan_time_s=a["plan_time_s"],
+        exec_time_s=a["exec_time_s"],
+    )
     cols = {
         "object": np.array([t.outcome.get("object", "") or "?" for t in scored], dtype=object),
         "method": np.array([col_of[t.run_key].label for t in scored], dtype=object),
     }
     groups = summarize_scores(s, cols, ("object", "method"), a["dropped"])
     metrics = ["err_pos", "err_pos_percent", "err_or_percent"]
-    return box_plot(groups, metrics, path,
-                    labels={m: f"{METRICS[m].label} ({METRICS[m].unit})" for m in metrics},
-                    scales={m: METRICS[m].scale for m in metrics},
-                    title=title or "In-hand results per object (Figure 7 layout)")
+    return box_plot(
+        groups,
+        metrics,
+        path,
+        labels={m: f"{METRICS[m].label} ({METRICS[m].unit})" for m in metrics},
+        scales={m: METRICS[m].scale for m in metrics},
+        title=title or "In-hand results per object (Figure 7 layout)",
+    )
 
 
 def _inhand_summary(rows: Sequence[StoredTrial]) -> dict[str, Any] | None:
@@ -367,13 +453,25 @@ def _inhand_summary(rows: Sequence[StoredTrial]) -> dict[str, Any] | None:
     if not ours:
         return None
     r = ours[0]
-    return {k: r[k] for k in ("trials", "discarded", "drops_percent", "err_pos_cm", "err_pos_percent", "err_or_percent")}
+    return {
+        k: r[k]
+        for k in (
+            "trials",
+            "discarded",
+            "drops_percent",
+            "err_pos_cm",
+            "err_pos_percent",
+            "err_or_percent",
+        )
+    }
 
 
 # -- backend comparison ------------------------------------------------------------------------
 
 
-def compare_backends(runs: Sequence[tuple[str, Sequence[StoredTrial]]], required: int | None) -> dict[str, Any]:
+def compare_backends(
+    runs: Sequence[tuple[str, Sequence[StoredTrial]]], required: int | None
+) -> dict[str, Any]:
     """``runs``: (backend, its trials). Per trial and per backend: status, score, cause, sim/wall time."""
     indices = sorted({t.trial_index for _, rows in runs for t in rows})
     per_trial = []
@@ -381,11 +479,18 @@ def compare_backends(runs: Sequence[tuple[str, Sequence[StoredTrial]]], required
         row: dict[str, Any] = {"trial": i}
         for backend, rows in runs:
             t = next((r for r in rows if r.trial_index == i), None)
-            row[backend] = None if t is None else {
-                "status": t.status.value, "score": t.score,
-                "cause": t.failure_cause.value if t.failure_cause else None,
-                "sim_s": t.sim_s, "wall_s": t.wall_s, "message": t.message,
-            }
+            row[backend] = (
+                None
+                if t is None
+                else {
+                    "status": t.status.value,
+                    "score": t.score,
+                    "cause": t.failure_cause.value if t.failure_cause else None,
+                    "sim_s": t.sim_s,
+                    "wall_s": t.wall_s,
+                    "message": t.message,
+                }
+            )
         per_trial.append(row)
     summary = {}
     for backend, rows in runs:
@@ -400,7 +505,9 @@ def compare_backends(runs: Sequence[tuple[str, Sequence[StoredTrial]]], required
             "mean_s": None if cell is None else cell.mean_s,
             "std_s": None if cell is None else cell.std_s,
             "causes": dict(Counter(t.failure_cause.value for t in rows if t.failure_cause)),
-            "real_time_factor": (sum(sims) / sum(walls)) if sims and walls and sum(walls) > 0 else None,
+            "real_time_factor": (sum(sims) / sum(walls))
+            if sims and walls and sum(walls) > 0
+            else None,
             "inhand": _inhand_summary(rows) if rows and rows[0].benchmark == "inhand" else None,
         }
     return {"trials": per_trial, "summary": summary}

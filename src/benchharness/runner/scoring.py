@@ -43,8 +43,12 @@ def _declared(outcome: TrialOutcome) -> FailureCause | None:
     return None if outcome.failure is None else FailureCause.parse(outcome.failure)
 
 
-def score_rubiks(item: RubiksItem, outcome: TrialOutcome, first_contact_s: float | None,
-                 termination_s: float | None) -> Verdict:
+def score_rubiks(
+    item: RubiksItem,
+    outcome: TrialOutcome,
+    first_contact_s: float | None,
+    termination_s: float | None,
+) -> Verdict:
     data: dict[str, Any] = {
         "tier": item.tier,
         "trial": item.trial,
@@ -58,15 +62,34 @@ def score_rubiks(item: RubiksItem, outcome: TrialOutcome, first_contact_s: float
     if declared is not None:
         return Verdict(TrialStatus.FAILURE, None, declared, outcome.message or declared.value, data)
     if outcome.final_state is None:
-        return Verdict(TrialStatus.FAILURE, None, FailureCause.STRATEGY_ERROR,
-                       "the strategy reported no final cube state and no failure cause", data)
+        return Verdict(
+            TrialStatus.FAILURE,
+            None,
+            FailureCause.STRATEGY_ERROR,
+            "the strategy reported no final cube state and no failure cause",
+            data,
+        )
     final = "".join(str(outcome.final_state).split())
-    trial = RubiksTrial(item.tier, item.trial, item.sequence_text, final, item.initial,
-                        first_contact_s, termination_s, outcome.message)
+    trial = RubiksTrial(
+        item.tier,
+        item.trial,
+        item.sequence_text,
+        final,
+        item.initial,
+        first_contact_s,
+        termination_s,
+        outcome.message,
+    )
     try:
         result = score_trial(trial, seed=item.seed)
     except TrialLogError as exc:
-        return Verdict(TrialStatus.FAILURE, None, FailureCause.STRATEGY_ERROR, f"cannot score the outcome: {exc}", data)
+        return Verdict(
+            TrialStatus.FAILURE,
+            None,
+            FailureCause.STRATEGY_ERROR,
+            f"cannot score the outcome: {exc}",
+            data,
+        )
     data["expected_final"] = result.expected_final
     if not result.success:
         return Verdict(TrialStatus.FAILURE, None, FailureCause.WRONG_STATE, result.reason, data)
@@ -104,25 +127,46 @@ def score_inhand(item: InhandItem, outcome: TrialOutcome) -> Verdict:
     except ValueError as exc:
         return Verdict(TrialStatus.FAILURE, None, FailureCause.STRATEGY_ERROR, str(exc), data)
     data.update(
-        reached=_list(reached), setup=_list(setup),
-        plan_time_s=_f(outcome.plan_time_s), exec_time_s=_f(outcome.exec_time_s),
-        reached_contacts=None if outcome.reached_contacts is None else np.asarray(outcome.reached_contacts, float).tolist(),
+        reached=_list(reached),
+        setup=_list(setup),
+        plan_time_s=_f(outcome.plan_time_s),
+        exec_time_s=_f(outcome.exec_time_s),
+        reached_contacts=None
+        if outcome.reached_contacts is None
+        else np.asarray(outcome.reached_contacts, float).tolist(),
     )
     if declared is not None and declared is not FailureCause.DROPPED:
         return Verdict(TrialStatus.FAILURE, None, declared, outcome.message or declared.value, data)
     if not dropped and not np.all(np.isfinite(reached)):
-        return Verdict(TrialStatus.FAILURE, None, FailureCause.STRATEGY_ERROR,
-                       "the strategy reported no reached pose and did not drop the object", data)
+        return Verdict(
+            TrialStatus.FAILURE,
+            None,
+            FailureCause.STRATEGY_ERROR,
+            "the strategy reported no reached pose and did not drop the object",
+            data,
+        )
     nan = np.nan
     s = score_trials(
-        item.initial[None], item.desired[None], reached[None], setup=setup[None], dropped=np.array([dropped]),
+        item.initial[None],
+        item.desired[None],
+        reached[None],
+        setup=setup[None],
+        dropped=np.array([dropped]),
         plan_time_s=np.array([nan if outcome.plan_time_s is None else outcome.plan_time_s], float),
         exec_time_s=np.array([nan if outcome.exec_time_s is None else outcome.exec_time_s], float),
     )
     data["metrics"] = {k: _f(v[0]) for k, v in s.values().items()}
     data["discarded"] = bool(s.discarded[0])
     if dropped:
-        return Verdict(TrialStatus.FAILURE, None, FailureCause.DROPPED, outcome.message or "object dropped", data)
+        return Verdict(
+            TrialStatus.FAILURE,
+            None,
+            FailureCause.DROPPED,
+            outcome.message or "object dropped",
+            data,
+        )
     if s.discarded[0]:
-        return Verdict(TrialStatus.DISCARDED, None, None, "set-up pose off by more than 10 % (discarded)", data)
+        return Verdict(
+            TrialStatus.DISCARDED, None, None, "set-up pose off by more than 10 % (discarded)", data
+        )
     return Verdict(TrialStatus.SUCCESS, _f(s.err_pos[0]), None, outcome.message, data)

@@ -39,7 +39,9 @@ def trial_streams(seed: int, task: str, trial_index: int, n_sensors: int = 0) ->
     The task enters through a hash of its name (case-folded, so ``rubiks-5-20``
     and ``Rubiks-5-20`` agree).
     """
-    root = np.random.SeedSequence(entropy=int(seed), spawn_key=(_word(task.strip().lower()), int(trial_index)))
+    root = np.random.SeedSequence(
+        entropy=int(seed), spawn_key=(_word(task.strip().lower()), int(trial_index))
+    )
     children = root.spawn(2 + n_sensors)
     backend_seed = int(children[1].generate_state(1, dtype=np.uint32)[0])
     return TrialStreams(

@@ -13,10 +13,11 @@ import hashlib
 import json
 import os
 import subprocess
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields, replace
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from .. import __version__
 from ..backends.interface import PhysicsConfig
@@ -52,7 +53,11 @@ def physics_hash(config: PhysicsConfig) -> str:
 
 def parse_physics(pairs: Mapping[str, str] | list[str]) -> PhysicsConfig:
     """A :class:`PhysicsConfig` from ``key=value`` strings (``gravity=0,0,-9.81``)."""
-    items = pairs.items() if isinstance(pairs, Mapping) else [p.split("=", 1) if "=" in p else (p, None) for p in pairs]
+    items = (
+        pairs.items()
+        if isinstance(pairs, Mapping)
+        else [p.split("=", 1) if "=" in p else (p, None) for p in pairs]
+    )
     known = {f.name: f for f in fields(PhysicsConfig)}
     base = PhysicsConfig()
     values: dict[str, Any] = {}
@@ -100,7 +105,10 @@ def code_version() -> str:
         try:
             out = subprocess.run(
                 ["git", "-C", str(root), "rev-parse", "--short=12", "HEAD"],
-                capture_output=True, text=True, timeout=10, check=False,
+                capture_output=True,
+                text=True,
+                timeout=10,
+                check=False,
             )
             if out.returncode == 0 and out.stdout.strip():
                 return f"{__version__}+g{out.stdout.strip()}"
@@ -160,7 +168,7 @@ class RunSpec:
     def run_key(self) -> str:
         return stable_hash(self.key_fields(), 20)
 
-    def with_backend(self, backend: str) -> "RunSpec":
+    def with_backend(self, backend: str) -> RunSpec:
         return replace(self, backend=backend)
 
     def to_json(self) -> dict[str, Any]:

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import signal
 import threading
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Iterator
 
 from ..backends.interface import CameraSpec
 from .contract import TrialContext, TrialTimeout
@@ -21,8 +21,13 @@ __all__ = ["StepHooks", "wall_alarm"]
 
 
 class StepHooks:
-    def __init__(self, ctx: TrialContext, video: VideoWriter | None = None,
-                 camera: CameraSpec | None = None, fps: float = 30.0) -> None:
+    def __init__(
+        self,
+        ctx: TrialContext,
+        video: VideoWriter | None = None,
+        camera: CameraSpec | None = None,
+        fps: float = 30.0,
+    ) -> None:
         self.ctx = ctx
         self.backend = ctx.backend
         self.video, self.camera, self.fps = video, camera, fps
@@ -76,14 +81,20 @@ def wall_alarm(seconds: float | None) -> Iterator[None]:
     Only on Unix and in the main thread (sweep workers and the CLI are); a
     little slack over the budget lets the per-step check speak first.
     """
-    usable = seconds is not None and hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
+    usable = (
+        seconds is not None
+        and hasattr(signal, "setitimer")
+        and threading.current_thread() is threading.main_thread()
+    )
     if not usable:
         yield
         return
     limit = float(seconds) * 1.1 + 1.0
 
-    def _raise(signum, frame):  # noqa: ARG001
-        raise TrialTimeout(f"wall-time budget of {seconds:g} s spent (no step returned for a while)")
+    def _raise(signum, frame):
+        raise TrialTimeout(
+            f"wall-time budget of {seconds:g} s spent (no step returned for a while)"
+        )
 
     old = signal.signal(signal.SIGALRM, _raise)
     signal.setitimer(signal.ITIMER_REAL, limit)

@@ -18,15 +18,23 @@ import math
 import os
 import sqlite3
 import time
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any
 
 from .causes import FailureCause, TrialStatus
 from .records import TrialRecord
 from .spec import RunSpec
 
-__all__ = ["DEFAULT_STORE", "SCHEMA_VERSION", "ResultsStore", "StoredTrial", "StoreError", "default_store_path"]
+__all__ = [
+    "DEFAULT_STORE",
+    "SCHEMA_VERSION",
+    "ResultsStore",
+    "StoredTrial",
+    "StoreError",
+    "default_store_path",
+]
 
 DEFAULT_STORE = "benchharness-results.sqlite"
 STORE_ENV = "BENCHHARNESS_STORE"
@@ -80,7 +88,17 @@ CREATE TABLE IF NOT EXISTS trials (
 CREATE INDEX IF NOT EXISTS trials_by_task ON trials (task, strategy, backend);
 """
 
-_KEY_COLUMNS = ("task", "robot", "strategy", "sensors", "backend", "seed", "physics_hash", "options_hash", "code_version")
+_KEY_COLUMNS = (
+    "task",
+    "robot",
+    "strategy",
+    "sensors",
+    "backend",
+    "seed",
+    "physics_hash",
+    "options_hash",
+    "code_version",
+)
 
 
 class StoreError(RuntimeError):
@@ -157,10 +175,15 @@ class StoredTrial:
 
     def comparable(self) -> dict[str, Any]:
         return {
-            "trial_index": self.trial_index, "status": self.status.value, "score": self.score,
-            "failure_cause": self.failure_cause.value if self.failure_cause else None, "sim_s": self.sim_s,
-            "first_contact_s": self.first_contact_s, "termination_s": self.termination_s,
-            "outcome": self.outcome, "diagnostics": self.diagnostics,
+            "trial_index": self.trial_index,
+            "status": self.status.value,
+            "score": self.score,
+            "failure_cause": self.failure_cause.value if self.failure_cause else None,
+            "sim_s": self.sim_s,
+            "first_contact_s": self.first_contact_s,
+            "termination_s": self.termination_s,
+            "outcome": self.outcome,
+            "diagnostics": self.diagnostics,
         }
 
 
@@ -189,7 +212,9 @@ class ResultsStore:
             row = self.conn.execute("SELECT max(version) FROM schema_version").fetchone()
             version = row[0]
             if version is None:
-                self.conn.execute("INSERT INTO schema_version (version) VALUES (?)", (SCHEMA_VERSION,))
+                self.conn.execute(
+                    "INSERT INTO schema_version (version) VALUES (?)", (SCHEMA_VERSION,)
+                )
             elif version > SCHEMA_VERSION:
                 raise StoreError(
                     f"{self.path} has schema version {version}, newer than this benchharness "
@@ -199,7 +224,7 @@ class ResultsStore:
     def close(self) -> None:
         self.conn.close()
 
-    def __enter__(self) -> "ResultsStore":
+    def __enter__(self) -> ResultsStore:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -213,12 +238,21 @@ class ResultsStore:
                 "INSERT OR IGNORE INTO runs (run_key, benchmark, task, robot, strategy, sensors, backend, seed,"
                 " physics_hash, options_hash, code_version, trials_total, spec_json, created_at)"
                 " VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
-                (spec.run_key, benchmark, *[k[c] for c in _KEY_COLUMNS], total, _json(spec.to_json()), time.time()),
+                (
+                    spec.run_key,
+                    benchmark,
+                    *[k[c] for c in _KEY_COLUMNS],
+                    total,
+                    _json(spec.to_json()),
+                    time.time(),
+                ),
             )
 
     def write(self, record: TrialRecord) -> None:
         """Insert (or replace) one trial and commit at once."""
-        run = self.conn.execute("SELECT * FROM runs WHERE run_key = ?", (record.run_key,)).fetchone()
+        run = self.conn.execute(
+            "SELECT * FROM runs WHERE run_key = ?", (record.run_key,)
+        ).fetchone()
         if run is None:
             raise StoreError(f"run {record.run_key} is not in the store (call ensure_run first)")
         values = {
@@ -242,7 +276,9 @@ class ResultsStore:
         cols = ", ".join(values)
         marks = ", ".join("?" for _ in values)
         with self.conn:
-            self.conn.execute(f"INSERT OR REPLACE INTO trials ({cols}) VALUES ({marks})", tuple(values.values()))
+            self.conn.execute(
+                f"INSERT OR REPLACE INTO trials ({cols}) VALUES ({marks})", tuple(values.values())
+            )
 
     # -- reading ---------------------------------------------------------------------------
     def finished(self, run_key: str, *, retry_failed: bool = False) -> set[int]:
@@ -252,8 +288,14 @@ class ResultsStore:
             sql += " AND status != 'failure'"
         return {r[0] for r in self.conn.execute(sql, (run_key,))}
 
-    def trials(self, *, run_key: str | None = None, benchmark: str | None = None, failures_only: bool = False,
-               **filters: str | int | Sequence | None) -> list[StoredTrial]:
+    def trials(
+        self,
+        *,
+        run_key: str | None = None,
+        benchmark: str | None = None,
+        failures_only: bool = False,
+        **filters: str | int | Sequence | None,
+    ) -> list[StoredTrial]:
         """Trials in run-creation then trial order; ``filters`` on key columns (value or list of values)."""
         where, args = [], []
         if run_key is not None:
@@ -283,22 +325,42 @@ class ResultsStore:
         return [self._row(r) for r in self.conn.execute(sql, args)]
 
     def runs(self) -> list[dict[str, Any]]:
-        return [dict(r) for r in self.conn.execute("SELECT * FROM runs ORDER BY created_at, run_key")]
+        return [
+            dict(r) for r in self.conn.execute("SELECT * FROM runs ORDER BY created_at, run_key")
+        ]
 
     def count(self, run_key: str) -> int:
-        return self.conn.execute("SELECT count(*) FROM trials WHERE run_key = ?", (run_key,)).fetchone()[0]
+        return self.conn.execute(
+            "SELECT count(*) FROM trials WHERE run_key = ?", (run_key,)
+        ).fetchone()[0]
 
     @staticmethod
     def _row(r: sqlite3.Row) -> StoredTrial:
         return StoredTrial(
-            run_key=r["run_key"], trial_index=r["trial_index"], benchmark=r["benchmark"], task=r["task"],
-            robot=r["robot"], strategy=r["strategy"], sensors=r["sensors"], backend=r["backend"], seed=r["seed"],
-            physics_hash=r["physics_hash"], options_hash=r["options_hash"], code_version=r["code_version"],
-            status=TrialStatus(r["status"]), score=r["score"],
+            run_key=r["run_key"],
+            trial_index=r["trial_index"],
+            benchmark=r["benchmark"],
+            task=r["task"],
+            robot=r["robot"],
+            strategy=r["strategy"],
+            sensors=r["sensors"],
+            backend=r["backend"],
+            seed=r["seed"],
+            physics_hash=r["physics_hash"],
+            options_hash=r["options_hash"],
+            code_version=r["code_version"],
+            status=TrialStatus(r["status"]),
+            score=r["score"],
             failure_cause=FailureCause(r["failure_cause"]) if r["failure_cause"] else None,
-            message=r["message"], wall_s=r["wall_s"], sim_s=r["sim_s"], first_contact_s=r["first_contact_s"],
-            termination_s=r["termination_s"], outcome=json.loads(r["outcome_json"]),
-            diagnostics=json.loads(r["diagnostics_json"]), traceback=r["traceback"], finished_at=r["finished_at"],
+            message=r["message"],
+            wall_s=r["wall_s"],
+            sim_s=r["sim_s"],
+            first_contact_s=r["first_contact_s"],
+            termination_s=r["termination_s"],
+            outcome=json.loads(r["outcome_json"]),
+            diagnostics=json.loads(r["diagnostics_json"]),
+            traceback=r["traceback"],
+            finished_at=r["finished_at"],
         )
 
 

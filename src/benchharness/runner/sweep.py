@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Callable, Iterator
 
 from .causes import FailureCause, TrialStatus
 from .plugins import lookup
@@ -65,7 +65,9 @@ def prepare(spec: RunSpec) -> TaskPlan:
     item = lookup("strategy", spec.strategy, spec.plugins)
     supported = item.meta.get("benchmarks") or getattr(item.factory, "benchmarks", None)
     if supported is not None and plan.benchmark not in tuple(supported):
-        raise ValueError(f"strategy {spec.strategy!r} runs {', '.join(supported)} tasks, not {plan.benchmark} ({plan.name})")
+        raise ValueError(
+            f"strategy {spec.strategy!r} runs {', '.join(supported)} tasks, not {plan.benchmark} ({plan.name})"
+        )
     return plan
 
 
@@ -110,8 +112,16 @@ def _quiet_stdout() -> Iterator[None]:
 
 def _crash_record(spec: RunSpec, index: int, detail: str) -> TrialRecord:
     return TrialRecord(
-        spec.run_key, index, TrialStatus.FAILURE, None, FailureCause.SIMULATOR_ERROR,
-        f"the worker process died while running this trial, twice ({detail})", 0.0, None, None, None,
+        spec.run_key,
+        index,
+        TrialStatus.FAILURE,
+        None,
+        FailureCause.SIMULATOR_ERROR,
+        f"the worker process died while running this trial, twice ({detail})",
+        0.0,
+        None,
+        None,
+        None,
     )
 
 
@@ -135,7 +145,9 @@ def run_sweep(
     if video is not None and video.trial_index not in plan.items:
         raise ValueError(f"--video-trial {video.trial_index}: this task has trials 1..{plan.total}")
     pending = [i for i in selected if i not in done or i in forced]
-    report = SweepReport(spec, plan, selected, skipped=[i for i in selected if i in done and i not in forced])
+    report = SweepReport(
+        spec, plan, selected, skipped=[i for i in selected if i in done and i not in forced]
+    )
     if on_start is not None:
         on_start(report, len(pending))
 
@@ -168,12 +180,20 @@ def run_sweep(
     return report
 
 
-def _drain(ctx, workers: int, queue: list[int], suspects: list[int], spec: RunSpec,
-           video: VideoSpec | None, finish: Callable[[TrialRecord], None]) -> bool:
+def _drain(
+    ctx,
+    workers: int,
+    queue: list[int],
+    suspects: list[int],
+    spec: RunSpec,
+    video: VideoSpec | None,
+    finish: Callable[[TrialRecord], None],
+) -> bool:
     """Run ``queue`` in one pool until empty or the pool breaks (then True; the
     in-flight trials are moved to ``suspects``)."""
-    pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(queue))), mp_context=ctx,
-                               initializer=_stdout_to_stderr)
+    pool = ProcessPoolExecutor(
+        max_workers=max(1, min(workers, len(queue))), mp_context=ctx, initializer=_stdout_to_stderr
+    )
     inflight: dict[Future, int] = {}
     try:
         while queue or inflight:

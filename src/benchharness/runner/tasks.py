@@ -35,7 +35,13 @@ class TaskPlan:
 def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
     if isinstance(task, RubiksTier):
         items: dict[int, TrialItem] = {
-            k: RubiksItem(task.name, k, task.trials, generate_sequence(seed, task.name, k, task.moves), int(seed))
+            k: RubiksItem(
+                task.name,
+                k,
+                task.trials,
+                generate_sequence(seed, task.name, k, task.moves),
+                int(seed),
+            )
             for k in range(1, task.trials + 1)
         }
         return TaskPlan(task.name, "rubiks", items)
@@ -46,14 +52,26 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
         items = {}
         idx = 1
         for row in range(len(task.task_id)):
-            contacts = {stage: np.asarray(c[row], float) for stage, c in (getattr(task, "contacts", None) or {}).items()}
+            contacts = {
+                stage: np.asarray(c[row], float)
+                for stage, c in (getattr(task, "contacts", None) or {}).items()
+            }
             contacts = {s: c[np.all(np.isfinite(c), axis=1)] for s, c in contacts.items()}
-            extra = {k: (v[row].item() if hasattr(v[row], "item") else v[row]) for k, v in (getattr(task, "extra", None) or {}).items()}
+            extra = {
+                k: (v[row].item() if hasattr(v[row], "item") else v[row])
+                for k, v in (getattr(task, "extra", None) or {}).items()
+            }
             for r in range(1, repeats + 1):
                 items[idx] = InhandItem(
-                    task_set=name, task_id=str(task.task_id[row]), object=str(task.object[row]),
-                    level=int(task.level[row]), initial=np.asarray(task.initial[row], float),
-                    desired=np.asarray(task.desired[row], float), repeat=r, contacts=contacts, extra=extra,
+                    task_set=name,
+                    task_id=str(task.task_id[row]),
+                    object=str(task.object[row]),
+                    level=int(task.level[row]),
+                    initial=np.asarray(task.initial[row], float),
+                    desired=np.asarray(task.desired[row], float),
+                    repeat=r,
+                    contacts=contacts,
+                    extra=extra,
                 )
                 idx += 1
         return TaskPlan(name, "inhand", items)
@@ -82,5 +100,7 @@ def parse_trial_selection(text: str | None, available: list[int]) -> list[int]:
             raise ValueError(f"--trials: cannot read {part!r} (use e.g. 1,3-5)") from None
     bad = sorted(set(chosen) - set(available))
     if bad:
-        raise ValueError(f"--trials: no trial {', '.join(map(str, bad))}; this task has trials 1..{max(available)}")
+        raise ValueError(
+            f"--trials: no trial {', '.join(map(str, bad))}; this task has trials 1..{max(available)}"
+        )
     return sorted(set(chosen))

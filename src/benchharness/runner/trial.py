@@ -45,11 +45,21 @@ def check_strategy_supports(strategy: Any, benchmark: str, name: str) -> None:
     if supported is not None and benchmark not in tuple(supported):
         raise ValueError(f"strategy {name!r} runs {', '.join(supported)} tasks, not {benchmark}")
     if not callable(getattr(strategy, "run_trial", None)):
-        raise TypeError(f"strategy {name!r} ({type(strategy).__name__}) has no run_trial(ctx) method")
+        raise TypeError(
+            f"strategy {name!r} ({type(strategy).__name__}) has no run_trial(ctx) method"
+        )
 
 
-def _failure(spec: RunSpec, index: int, cause: FailureCause, message: str, wall0: float,
-             ctx: TrialContext | None, trace: str = "", outcome: dict | None = None) -> TrialRecord:
+def _failure(
+    spec: RunSpec,
+    index: int,
+    cause: FailureCause,
+    message: str,
+    wall0: float,
+    ctx: TrialContext | None,
+    trace: str = "",
+    outcome: dict | None = None,
+) -> TrialRecord:
     sim_s = None
     first = None
     diag: dict = {}
@@ -61,8 +71,19 @@ def _failure(spec: RunSpec, index: int, cause: FailureCause, message: str, wall0
         first = ctx.recorder.first_contact_s
         diag = ctx.recorder.to_json()
     return TrialRecord(
-        spec.run_key, index, TrialStatus.FAILURE, None, cause, message, time.perf_counter() - wall0,
-        sim_s, first, None, outcome or {}, diag, trace,
+        spec.run_key,
+        index,
+        TrialStatus.FAILURE,
+        None,
+        cause,
+        message,
+        time.perf_counter() - wall0,
+        sim_s,
+        first,
+        None,
+        outcome or {},
+        diag,
+        trace,
     )
 
 
@@ -90,9 +111,18 @@ def execute_trial(spec: RunSpec, index: int, video: VideoSpec | None = None) -> 
         check_strategy_supports(strategy, plan.benchmark, spec.strategy)
         recorder = TrialRecorder(clock=lambda: float(backend.time))
         ctx = TrialContext(
-            item=item, trial_index=index, robot=robot, backend=backend, sensors=sensors,
-            rng=streams.strategy, budget=spec.budget, recorder=recorder, physics=physics,
-            run=spec.key_fields(), wall_start=wall0, sim_start=float(backend.time),
+            item=item,
+            trial_index=index,
+            robot=robot,
+            backend=backend,
+            sensors=sensors,
+            rng=streams.strategy,
+            budget=spec.budget,
+            recorder=recorder,
+            physics=physics,
+            run=spec.key_fields(),
+            wall_start=wall0,
+            sim_start=float(backend.time),
         )
         if video is not None and video.trial_index == index:
             camera = video.camera or getattr(strategy, "video_camera", None) or DEFAULT_CAMERA
@@ -105,13 +135,25 @@ def execute_trial(spec: RunSpec, index: int, video: VideoSpec | None = None) -> 
         with wall_alarm(spec.budget.wall_s):
             outcome = strategy.run_trial(ctx)
         if not isinstance(outcome, TrialOutcome):
-            return _failure(spec, index, FailureCause.STRATEGY_ERROR,
-                            f"run_trial returned {type(outcome).__name__}, not TrialOutcome", wall0, ctx)
+            return _failure(
+                spec,
+                index,
+                FailureCause.STRATEGY_ERROR,
+                f"run_trial returned {type(outcome).__name__}, not TrialOutcome",
+                wall0,
+                ctx,
+            )
         end = float(backend.time)
         sim_s = end - ctx.sim_start
         if spec.budget.sim_s is not None and sim_s > spec.budget.sim_s:
-            raise TrialTimeout(f"simulated-time budget of {spec.budget.sim_s:g} s spent ({sim_s:.3f} s)")
-        first = outcome.first_contact_s if outcome.first_contact_s is not None else recorder.first_contact_s
+            raise TrialTimeout(
+                f"simulated-time budget of {spec.budget.sim_s:g} s spent ({sim_s:.3f} s)"
+            )
+        first = (
+            outcome.first_contact_s
+            if outcome.first_contact_s is not None
+            else recorder.first_contact_s
+        )
         termination = outcome.termination_s if outcome.termination_s is not None else end
         if plan.benchmark == "rubiks":
             verdict: Verdict = score_rubiks(item, outcome, first, termination)  # type: ignore[arg-type]
@@ -119,19 +161,43 @@ def execute_trial(spec: RunSpec, index: int, video: VideoSpec | None = None) -> 
             verdict = score_inhand(item, outcome)  # type: ignore[arg-type]
         diag = recorder.to_json()
         if writer is not None:
-            diag["video"] = {"path": str(writer.path), "frames": writer.frames_written, "fps": video.fps, "note": writer.note}
+            diag["video"] = {
+                "path": str(writer.path),
+                "frames": writer.frames_written,
+                "fps": video.fps,
+                "note": writer.note,
+            }
         return TrialRecord(
-            spec.run_key, index, verdict.status, verdict.score, verdict.cause, verdict.message,
-            time.perf_counter() - wall0, sim_s, first, termination, verdict.outcome, diag,
+            spec.run_key,
+            index,
+            verdict.status,
+            verdict.score,
+            verdict.cause,
+            verdict.message,
+            time.perf_counter() - wall0,
+            sim_s,
+            first,
+            termination,
+            verdict.outcome,
+            diag,
         )
     except TrialTimeout as exc:
         return _failure(spec, index, FailureCause.TIMEOUT, str(exc), wall0, ctx, tb.format_exc())
     except SimulationError as exc:
-        return _failure(spec, index, FailureCause.SIMULATOR_ERROR, f"{type(exc).__name__}: {exc}", wall0, ctx,
-                        tb.format_exc())
+        return _failure(
+            spec,
+            index,
+            FailureCause.SIMULATOR_ERROR,
+            f"{type(exc).__name__}: {exc}",
+            wall0,
+            ctx,
+            tb.format_exc(),
+        )
     except Exception as exc:  # noqa: BLE001 - any failure ends this trial only
         cause = FailureCause.SIMULATOR_ERROR if backend is None else FailureCause.STRATEGY_ERROR
-        return _failure(spec, index, cause, f"{stage}: {type(exc).__name__}: {exc}", wall0, ctx, tb.format_exc())
+        return _failure(
+            spec, index, cause, f"{stage}: {type(exc).__name__}: {exc}", wall0, ctx, tb.format_exc()
+        )
     finally:
         if hooks is not None:
             hooks.uninstall()

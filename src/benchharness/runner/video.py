@@ -21,7 +21,9 @@ from ..backends.interface import CameraSpec
 __all__ = ["VideoSpec", "VideoWriter", "VideoUnavailable", "DEFAULT_CAMERA"]
 
 #: Looks at the middle of a PR2-sized workspace from the front right, above the table.
-DEFAULT_CAMERA = CameraSpec(eye=(1.6, -1.0, 1.4), target=(0.6, 0.0, 0.75), width=480, height=360, fov_deg=50.0)
+DEFAULT_CAMERA = CameraSpec(
+    eye=(1.6, -1.0, 1.4), target=(0.6, 0.0, 0.75), width=480, height=360, fov_deg=50.0
+)
 
 
 class VideoUnavailable(RuntimeError):
@@ -73,8 +75,14 @@ class VideoWriter:
 
                 w, h = self.size
                 self._gen = imageio_ffmpeg.write_frames(
-                    str(self.path), (w, h), fps=self.fps, codec="libx264", pix_fmt_out="yuv420p",
-                    macro_block_size=2, quality=7, ffmpeg_log_level="error",
+                    str(self.path),
+                    (w, h),
+                    fps=self.fps,
+                    codec="libx264",
+                    pix_fmt_out="yuv420p",
+                    macro_block_size=2,
+                    quality=7,
+                    ffmpeg_log_level="error",
                 )
                 self._gen.send(None)
             else:
@@ -103,6 +111,10 @@ class VideoWriter:
 
             images = [Image.fromarray(f) for f in self._gif]
             images[0].save(
-                self.path, save_all=True, append_images=images[1:], duration=max(1, round(1000 / self.fps)), loop=0
+                self.path,
+                save_all=True,
+                append_images=images[1:],
+                duration=max(1, round(1000 / self.fps)),
+                loop=0,
             )
             self._gif = []

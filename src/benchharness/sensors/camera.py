@@ -39,10 +39,14 @@ class HeadCamera:
         """6×6 covariance over (x, y, z, roll, pitch, yaw), m and rad."""
         c = self.config
         tilt = np.deg2rad(c.tilt_std_deg)
-        std = np.array([c.pos_std_xy, c.pos_std_xy, c.pos_std_z, tilt, tilt, np.deg2rad(c.yaw_std_deg)])
+        std = np.array(
+            [c.pos_std_xy, c.pos_std_xy, c.pos_std_z, tilt, tilt, np.deg2rad(c.yaw_std_deg)]
+        )
         return np.diag(std**2)
 
-    def estimate(self, true_pose: Pose, rng: np.random.Generator, *, time: float = 0.0) -> PoseEstimate:
+    def estimate(
+        self, true_pose: Pose, rng: np.random.Generator, *, time: float = 0.0
+    ) -> PoseEstimate:
         """An estimate of ``true_pose``: position plus noise, orientation perturbed in the world frame."""
         if not isinstance(rng, np.random.Generator):
             raise TypeError("rng must be a numpy.random.Generator (seed it explicitly)")
@@ -50,8 +54,14 @@ class HeadCamera:
         noise = rng.standard_normal(6) * np.sqrt(np.diag(cov))
         p = true_pose.p + noise[:3]
         rot = Rotation.from_euler("xyz", noise[3:]) * true_pose.rotation
-        return PoseEstimate(Pose.from_rotation(p, rot), cov, n_measurements=1, time=float(time),
-                            axes=CAMERA_AXES, source=self.name)
+        return PoseEstimate(
+            Pose.from_rotation(p, rot),
+            cov,
+            n_measurements=1,
+            time=float(time),
+            axes=CAMERA_AXES,
+            source=self.name,
+        )
 
     def observe(self, backend: Backend, body: BodyId, rng: np.random.Generator) -> PoseEstimate:
         """Estimate the pose of ``body`` as the camera would see it now."""

@@ -89,11 +89,17 @@ class ToFConfig:
     noise_std_per_m: float = 0.01
 
     def __post_init__(self) -> None:
-        _check_nonneg("ToFConfig", min_range=self.min_range, noise_std=self.noise_std,
-                      noise_std_per_m=self.noise_std_per_m)
+        _check_nonneg(
+            "ToFConfig",
+            min_range=self.min_range,
+            noise_std=self.noise_std,
+            noise_std_per_m=self.noise_std_per_m,
+        )
         _check_pos("ToFConfig", max_range=self.max_range)
         if self.min_range >= self.max_range:
-            raise ValueError(f"ToFConfig.min_range ({self.min_range}) must be below max_range ({self.max_range})")
+            raise ValueError(
+                f"ToFConfig.min_range ({self.min_range}) must be below max_range ({self.max_range})"
+            )
 
     def std_at(self, distance: float) -> float:
         """Range noise std (m) at ``distance`` (m)."""
@@ -145,9 +151,13 @@ class CubeFilterConfig:
     def __post_init__(self) -> None:
         _check_pos("CubeFilterConfig", edge=self.edge, gate_sigma=self.gate_sigma)
         if not 0.0 < self.max_incidence_deg < 90.0:
-            raise ValueError(f"CubeFilterConfig.max_incidence_deg must be in (0, 90), got {self.max_incidence_deg!r}")
+            raise ValueError(
+                f"CubeFilterConfig.max_incidence_deg must be in (0, 90), got {self.max_incidence_deg!r}"
+            )
         if int(self.max_iterations) != self.max_iterations or self.max_iterations < 1:
-            raise ValueError(f"CubeFilterConfig.max_iterations must be a positive integer, got {self.max_iterations!r}")
+            raise ValueError(
+                f"CubeFilterConfig.max_iterations must be a positive integer, got {self.max_iterations!r}"
+            )
         _check_nonneg(
             "CubeFilterConfig",
             process_pos_std=self.process_pos_std,

@@ -33,7 +33,9 @@ class PoseEstimate:
 
     pose: Pose
     covariance: np.ndarray
-    n_measurements: int = 0  #: measurements fused so far (camera: 1; filter: accepted ranges + priors)
+    n_measurements: int = (
+        0  #: measurements fused so far (camera: 1; filter: accepted ranges + priors)
+    )
     time: float = 0.0  #: simulated seconds at which the estimate holds
     axes: tuple[str, ...] = field(default=FILTER_AXES)
     source: str = ""  #: what produced it ("head-camera", "cube-kf", ...)
@@ -42,7 +44,9 @@ class PoseEstimate:
         cov = np.array(self.covariance, dtype=float)
         k = len(self.axes)
         if cov.shape != (k, k):
-            raise ValueError(f"covariance must be {k}x{k} over axes {self.axes}, got shape {cov.shape}")
+            raise ValueError(
+                f"covariance must be {k}x{k} over axes {self.axes}, got shape {cov.shape}"
+            )
         if not np.all(np.isfinite(cov)):
             raise ValueError("covariance must be finite")
         cov = 0.5 * (cov + cov.T)

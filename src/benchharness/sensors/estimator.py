@@ -32,8 +32,8 @@ step.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
@@ -67,7 +67,9 @@ class UpdateReport:
     n_predicted_miss: int  #: returned, but the estimate's box is off the ray, or the hit is near an edge or grazing
     n_gated: int  #: innovation beyond the gate
     nis: float  #: normalised innovation squared of the fused batch (χ² with n_used dof if consistent)
-    fused: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))  #: (n_rays,) which rays were fused
+    fused: np.ndarray = field(
+        default_factory=lambda: np.zeros(0, dtype=bool)
+    )  #: (n_rays,) which rays were fused
 
 
 class CubePoseFilter:
@@ -116,8 +118,14 @@ class CubePoseFilter:
         self._require_init()
         x = self.x
         pose = Pose.from_rotation(x[:3], level_rotation(x[3]))
-        return PoseEstimate(pose, self.P, n_measurements=self._n, time=self._time, axes=FILTER_AXES,
-                            source=self.name)
+        return PoseEstimate(
+            pose,
+            self.P,
+            n_measurements=self._n,
+            time=self._time,
+            axes=FILTER_AXES,
+            source=self.name,
+        )
 
     def initialize(self, prior: PoseEstimate) -> None:
         """Start from a prior (usually the head camera's): its x, y, z and yaw marginal."""
@@ -152,7 +160,9 @@ class CubePoseFilter:
         """Q (4×4) for a commanded motion of ``translation`` m and ``rotation`` rad."""
         c = self.config
         s_p = math.hypot(c.process_pos_std, c.process_pos_std_per_m * abs(translation))
-        s_y = math.hypot(math.radians(c.process_yaw_std_deg), c.process_yaw_std_per_deg * abs(rotation))
+        s_y = math.hypot(
+            math.radians(c.process_yaw_std_deg), c.process_yaw_std_per_deg * abs(rotation)
+        )
         return np.diag([s_p**2, s_p**2, s_p**2, s_y**2])
 
     def predict(
@@ -173,7 +183,9 @@ class CubePoseFilter:
         self._require_init()
         dp = np.asarray(delta_p, dtype=float).reshape(3)
         u = np.array([*dp, float(delta_yaw)]).reshape(_DIM, 1)
-        rot = abs(float(delta_yaw)) if rotation_magnitude is None else abs(float(rotation_magnitude))
+        rot = (
+            abs(float(delta_yaw)) if rotation_magnitude is None else abs(float(rotation_magnitude))
+        )
         self._kf.Q = self.process_noise(float(np.linalg.norm(dp)), rot)
         self._kf.predict(u=u)
         self._kf.x[3, 0] = wrap_quarter(self._kf.x[3, 0])
@@ -193,7 +205,9 @@ class CubePoseFilter:
         old = Pose.from_rotation(x[:3], level_rotation(x[3]))
         new = delta * old
         d_yaw = wrap_quarter(cube_yaw(new.rotation) - x[3])
-        self.predict(new.p - old.p, d_yaw, rotation_magnitude=float(delta.rotation.magnitude()), time=time)
+        self.predict(
+            new.p - old.p, d_yaw, rotation_magnitude=float(delta.rotation.magnitude()), time=time
+        )
         return cube_tilt(new.rotation)
 
     # -- update ----------------------------------------------------------------
@@ -234,7 +248,9 @@ class CubePoseFilter:
         d = np.atleast_2d(np.asarray(directions, dtype=float))
         z = np.asarray(distances, dtype=float).reshape(-1)
         if o.shape != d.shape or o.shape != (z.size, 3):
-            raise ValueError(f"origins {o.shape}, directions {d.shape} and distances {z.shape} disagree")
+            raise ValueError(
+                f"origins {o.shape}, directions {d.shape} and distances {z.shape} disagree"
+            )
         d = d / np.linalg.norm(d, axis=1, keepdims=True)
         cfg = self.config
         gate2 = cfg.gate_sigma**2
@@ -256,7 +272,9 @@ class CubePoseFilter:
         for _ in range(self.config.max_iterations):
             pred, jac = self._predict_ranges(xi, o, d)
             cos_inc = -np.einsum("ij,ij->i", np.where(pred.hit[:, None], pred.normal, 0.0), d)
-            predicted = returned & pred.hit & (pred.edge_distance >= cfg.edge_margin) & (cos_inc >= cos_max)
+            predicted = (
+                returned & pred.hit & (pred.edge_distance >= cfg.edge_margin) & (cos_inc >= cos_max)
+            )
             resid = np.where(predicted, z - np.where(predicted, pred.distance, 0.0), np.inf)
             jac_safe = np.where(predicted[:, None], jac, 0.0)
             s_gate = np.einsum("ij,jk,ik->i", jac_safe, p_gate, jac_safe) + r_diag
@@ -296,13 +314,19 @@ class CubePoseFilter:
         self._set_time(time)
         n_no = int((~returned).sum())
         n_miss = int((returned & ~predicted).sum())
-        return UpdateReport(int(z.size), n_used, n_no, n_miss, int(z.size) - n_used - n_no - n_miss, nis, inl.copy())
+        return UpdateReport(
+            int(z.size), n_used, n_no, n_miss, int(z.size) - n_used - n_no - n_miss, nis, inl.copy()
+        )
 
     def update_reading(self, reading: ToFReading | Scan) -> UpdateReport:
         """Fuse a :class:`ToFReading` or a whole :class:`Scan` (its believed rays)."""
-        return self.update_ranges(reading.origins, reading.directions, reading.distance, time=reading.time)
+        return self.update_ranges(
+            reading.origins, reading.directions, reading.distance, time=reading.time
+        )
 
-    def update_support(self, height: float, std: float = 0.0005, *, time: float | None = None) -> None:
+    def update_support(
+        self, height: float, std: float = 0.0005, *, time: float | None = None
+    ) -> None:
         """The cube rests on a horizontal surface at ``height`` (m): its centre is ``edge/2`` above.
 
         ``std`` (m) is how well the surface height is known (0.5 mm: a fitted

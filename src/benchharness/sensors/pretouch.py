@@ -14,8 +14,8 @@ estimator never looks at it (it gates by innovation instead).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -37,7 +37,12 @@ class Emitter:
     def __post_init__(self) -> None:
         o = np.asarray(self.origin, dtype=float)
         d = np.asarray(self.direction, dtype=float)
-        if o.shape != (3,) or d.shape != (3,) or not np.all(np.isfinite(o)) or not np.all(np.isfinite(d)):
+        if (
+            o.shape != (3,)
+            or d.shape != (3,)
+            or not np.all(np.isfinite(o))
+            or not np.all(np.isfinite(d))
+        ):
             raise ValueError("an Emitter needs a finite 3-vector origin and direction")
         if np.linalg.norm(d) < 1e-9:
             raise ValueError("an Emitter's direction must be non-zero")
@@ -111,7 +116,9 @@ class PreTouchSensor:
         """World origins and unit directions, (n, 3) each, for a given link pose."""
         return link_pose.apply(self._o), link_pose.rotation.apply(self._d)
 
-    def read(self, rng: np.random.Generator, *, believed_link_pose: Pose | None = None) -> ToFReading:
+    def read(
+        self, rng: np.random.Generator, *, believed_link_pose: Pose | None = None
+    ) -> ToFReading:
         """Cast every emitter's ray once (one batched call) and add range noise.
 
         Rays are cast from the link's true pose. The reading reports them from
@@ -125,8 +132,9 @@ class PreTouchSensor:
         o, d = self.rays(true_pose)
         # The range window applies to the true range (whether light comes back);
         # noise is added after, so a reading near a limit may stray past it.
-        hits = self.backend.ray_cast(o, d, cfg.max_range, ignore_bodies=self.ignore_bodies,
-                                     ignore_links=self.ignore_links)
+        hits = self.backend.ray_cast(
+            o, d, cfg.max_range, ignore_bodies=self.ignore_bodies, ignore_links=self.ignore_links
+        )
         true_d = np.where(hits.hit & (hits.distance <= cfg.max_range), hits.distance, np.inf)
         noise = rng.standard_normal(len(true_d))  # drawn for every ray: same stream whatever is hit
         finite = np.isfinite(true_d)
@@ -136,8 +144,14 @@ class PreTouchSensor:
         measured[finite & (true_d < cfg.min_range)] = np.nan
         if believed_link_pose is not None:
             o, d = self.rays(believed_link_pose)
-        return ToFReading(o, d, measured, true_d, np.where(hits.hit, hits.body, -1).astype(int),
-                          time=float(self.backend.time))
+        return ToFReading(
+            o,
+            d,
+            measured,
+            true_d,
+            np.where(hits.hit, hits.body, -1).astype(int),
+            time=float(self.backend.time),
+        )
 
 
 @dataclass(frozen=True)
@@ -149,7 +163,10 @@ class Scan:
 
     def _cat(self, name: str) -> np.ndarray:
         if not self.readings:
-            return np.zeros((0, 3) if name in ("origins", "directions") else 0, dtype=int if name == "body" else float)
+            return np.zeros(
+                (0, 3) if name in ("origins", "directions") else 0,
+                dtype=int if name == "body" else float,
+            )
         return np.concatenate([getattr(r, name) for r in self.readings], axis=0)
 
     @property

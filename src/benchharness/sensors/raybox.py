@@ -35,7 +35,9 @@ class RayBoxHits:
     point: np.ndarray  #: (n, 3) world entry point; NaN where not hit
     normal: np.ndarray  #: (n, 3) world outward normal of the face entered; NaN where not hit
     face_axis: np.ndarray  #: (n,) box-frame axis (0, 1, 2) of the face entered; -1 where not hit
-    edge_distance: np.ndarray  #: (n,) distance (m) from the entry point to the face's nearest edge; NaN where not hit
+    edge_distance: (
+        np.ndarray
+    )  #: (n,) distance (m) from the entry point to the face's nearest edge; NaN where not hit
 
 
 def _as_rows(a: np.ndarray, name: str) -> np.ndarray:

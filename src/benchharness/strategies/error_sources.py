@@ -38,10 +38,12 @@ class ErrorConfig:
     #: use the head camera at all (False = the initial estimate is the true pose)
     camera: bool = True
 
-    def zero(self) -> "ErrorConfig":
+    def zero(self) -> ErrorConfig:
         """Every error off (the ``-exact`` diagnostics)."""
         return ErrorConfig(**{f.name: (False if f.name == "camera" else 0.0) for f in fields(self)})
 
     @property
     def is_zero(self) -> bool:
-        return not self.camera and all(getattr(self, f.name) == 0.0 for f in fields(self) if f.name != "camera")
+        return not self.camera and all(
+            getattr(self, f.name) == 0.0 for f in fields(self) if f.name != "camera"
+        )

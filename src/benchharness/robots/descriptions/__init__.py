@@ -7,8 +7,8 @@ rewrites the files. A test checks that the shipped files match.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from ..urdf_builder import UrdfModel
 
@@ -19,7 +19,12 @@ def generators() -> dict[str, Callable[[], UrdfModel]]:
     """Robot name -> function building its :class:`UrdfModel`."""
     from . import allegro, herb, pr2, pr2_gripper
 
-    return {"pr2": pr2.build, "herb": herb.build, "allegro": allegro.build, "pr2_gripper": pr2_gripper.build}
+    return {
+        "pr2": pr2.build,
+        "herb": herb.build,
+        "allegro": allegro.build,
+        "pr2_gripper": pr2_gripper.build,
+    }
 
 
 def write_all(root: Path) -> list[Path]:

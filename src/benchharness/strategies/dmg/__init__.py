@@ -37,7 +37,10 @@ REGISTRATIONS = [
         "dmg",
         make_planner,
         "Dexterous Manipulation Graph planner (parallel gripper, Levels II/III); runs on pr2-gripper",
-        {"levels": [2, 3], "hand": "parallel gripper (YuMi smart gripper model; executed by pr2-gripper)",
-         "benchmarks": ["inhand"]},
+        {
+            "levels": [2, 3],
+            "hand": "parallel gripper (YuMi smart gripper model; executed by pr2-gripper)",
+            "benchmarks": ["inhand"],
+        },
     )
 ]

@@ -42,7 +42,14 @@ from ...geometry import Pose
 from ...runner.contract import TrialContext, TrialOutcome
 from ..pivoting.config import ExecutionConfig
 
-__all__ = ["DMGExecConfig", "execute_trial", "plan_waypoints", "plan_to_region", "choose_rest", "Waypoint"]
+__all__ = [
+    "DMGExecConfig",
+    "execute_trial",
+    "plan_waypoints",
+    "plan_to_region",
+    "choose_rest",
+    "Waypoint",
+]
 
 
 @dataclass(frozen=True)
@@ -93,7 +100,9 @@ def plan_waypoints(dmg, plan) -> list[Waypoint]:
             pose = _hand_pose(dmg, patch, plan.start.theta)
             kind = "setup"
         elif i == len(plan.states) - 1:
-            pose = Pose.from_rotation(plan.final.position, Rotation.from_quat(plan.final.quaternion))
+            pose = Pose.from_rotation(
+                plan.final.position, Rotation.from_quat(plan.final.quaternion)
+            )
             kind = "rotate" if patch == prev else "translate"
         else:
             pose = _hand_pose(dmg, patch, k * step)
@@ -101,8 +110,13 @@ def plan_waypoints(dmg, plan) -> list[Waypoint]:
         out.append(Waypoint(kind, pose, patch))
         prev = patch
     if len(plan.states) == 1:  # a rotation within the start node
-        out.append(Waypoint("rotate", Pose.from_rotation(plan.final.position, Rotation.from_quat(plan.final.quaternion)),
-                            out[0].patch))
+        out.append(
+            Waypoint(
+                "rotate",
+                Pose.from_rotation(plan.final.position, Rotation.from_quat(plan.final.quaternion)),
+                out[0].patch,
+            )
+        )
     return out
 
 
@@ -137,10 +151,19 @@ def plan_to_region(dmg, initial, desired_contacts: np.ndarray):
         raise NoPlanError("no admissible state faces the desired region")
     patch = int(usable[np.argmin(np.linalg.norm(pt.centers[usable] - p, axis=1))])
     dist, paths = nx.single_source_dijkstra(dmg.graph, start.state, weight="weight")
-    goals = [dmg.state(patch, k) for k in np.flatnonzero(dmg.admissible[patch]) if dmg.state(patch, k) in dist]
+    goals = [
+        dmg.state(patch, k)
+        for k in np.flatnonzero(dmg.admissible[patch])
+        if dmg.state(patch, k) in dist
+    ]
     reached = bool(goals)
     if not goals:  # disconnected: the reachable state nearest the region
-        goals = [min(sorted(dist), key=lambda s: (np.linalg.norm(pt.centers[dmg.unstate(s)[0]] - p), dist[s]))]
+        goals = [
+            min(
+                sorted(dist),
+                key=lambda s: (np.linalg.norm(pt.centers[dmg.unstate(s)[0]] - p), dist[s]),
+            )
+        ]
     best = min(goals, key=lambda s: (dist[s], s))
     path = paths[best]
     end_patch, end_k = dmg.unstate(path[-1])
@@ -148,8 +171,16 @@ def plan_to_region(dmg, initial, desired_contacts: np.ndarray):
     prims = _primitives(dmg, path, start.theta, theta_end)
     final = _final_grasp(dmg, end_patch, theta_end, start.principal)
     goal = snap_grasp(dmg, final, principal=start.principal)
-    return Plan(start=start, goal=goal, states=tuple(int(s) for s in path), primitives=prims, final=final,
-                cost=float(dist[best]), reached_goal=reached, plan_time_s=time.perf_counter() - t0)
+    return Plan(
+        start=start,
+        goal=goal,
+        states=tuple(int(s) for s in path),
+        primitives=prims,
+        final=final,
+        cost=float(dist[best]),
+        reached_goal=reached,
+        plan_time_s=time.perf_counter() - t0,
+    )
 
 
 def choose_rest(model, poses: list[Pose], width: float, cfg: ExecutionConfig) -> tuple[Pose, float]:
@@ -165,7 +196,10 @@ def choose_rest(model, poses: list[Pose], width: float, cfg: ExecutionConfig) ->
     if not rests:
         return None, -np.inf
     opening = width + 0.03
-    scored = [(min(clearance(r * h, opening, cfg.motion.table_height) for h in poses), i, r) for i, r in enumerate(rests)]
+    scored = [
+        (min(clearance(r * h, opening, cfg.motion.table_height) for h in poses), i, r)
+        for i, r in enumerate(rests)
+    ]
     c, _, rest = max(scored, key=lambda t: (t[0], -t[1]))
     return rest, c
 
@@ -175,8 +209,10 @@ def _task_set(item):
 
     c = item.contacts or {}
     return TaskSet(
-        task_id=np.array([item.task_id], dtype=object), object=np.array([item.object], dtype=object),
-        level=np.array([item.level]), initial=np.asarray(item.initial, float)[None],
+        task_id=np.array([item.task_id], dtype=object),
+        object=np.array([item.object], dtype=object),
+        level=np.array([item.level]),
+        initial=np.asarray(item.initial, float)[None],
         desired=np.asarray(item.desired, float)[None],
         contacts={k: np.asarray(v, float)[None] for k, v in c.items()},
     )
@@ -194,7 +230,9 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
     if getattr(item, "benchmark", None) != "inhand":
         raise ValueError("the DMG strategy runs in-hand tasks")
     if getattr(ctx.robot, "name", "") != "pr2-gripper":
-        raise ValueError(f"DMG execution drives the pr2-gripper robot, got {getattr(ctx.robot, 'name', ctx.robot)!r}")
+        raise ValueError(
+            f"DMG execution drives the pr2-gripper robot, got {getattr(ctx.robot, 'name', ctx.robot)!r}"
+        )
     for stage in ("initial", "desired"):
         c = (item.contacts or {}).get(stage)
         if c is None or len(c) < 2:
@@ -207,17 +245,34 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
     ini_q = pl.quat_to_ours(np.asarray(item.initial[3:], float))
     try:
         if level2:
-            plan = plan_to_region(dmg, Grasp(ini_c, ini_q), pl.to_ours(np.asarray(item.contacts["desired"], float)[:2]))
+            plan = plan_to_region(
+                dmg,
+                Grasp(ini_c, ini_q),
+                pl.to_ours(np.asarray(item.contacts["desired"], float)[:2]),
+            )
         else:
             plan = planner.plan_task(_task_set(item), 0).plan
     except NoPlanError as e:
-        return TrialOutcome(failure="unreachable", message=f"no DMG plan: {e}", extra={"dmg_time_s": dmg.build_time_s})
-    info = {"dmg_time_s": dmg.build_time_s, "reached_goal_node": plan.reached_goal,
-            "primitives": [(p.kind, round(math.degrees(p.angle), 2) if p.kind == "rotate" else round(p.length, 4))
-                           for p in plan.primitives]}
+        return TrialOutcome(
+            failure="unreachable",
+            message=f"no DMG plan: {e}",
+            extra={"dmg_time_s": dmg.build_time_s},
+        )
+    info = {
+        "dmg_time_s": dmg.build_time_s,
+        "reached_goal_node": plan.reached_goal,
+        "primitives": [
+            (p.kind, round(math.degrees(p.angle), 2) if p.kind == "rotate" else round(p.length, 4))
+            for p in plan.primitives
+        ],
+    }
     if cfg.require_goal and not plan.reached_goal:
-        return TrialOutcome(failure="unreachable", message="the DMG goal is not connected to the start",
-                            plan_time_s=plan.plan_time_s, extra=info)
+        return TrialOutcome(
+            failure="unreachable",
+            message="the DMG goal is not connected to the start",
+            plan_time_s=plan.plan_time_s,
+            extra=info,
+        )
     # the set-up grasp: the task's initial grasp moved onto our mesh along its closing line
     zi = Rotation.from_quat(ini_q).apply([0.0, 0.0, 1.0])
     on, _ = surface_contacts(dmg.mesh, ini_c, zi)
@@ -227,14 +282,24 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
     waypoints = plan_waypoints(dmg, plan)
     prims = group_primitives(waypoints)
     model = load_object(obj, resolution=planner.resolution)
-    pre = Pose(setup_pose.p - setup_pose.rotation.apply([ex.setup.approach_clearance, 0.0, 0.0]), setup_pose.q)
+    pre = Pose(
+        setup_pose.p - setup_pose.rotation.apply([ex.setup.approach_clearance, 0.0, 0.0]),
+        setup_pose.q,
+    )
     rest, worst = choose_rest(model, [setup_pose, pre] + [w.pose for w in waypoints], width, ex)
     info["rest_clearance_mm"] = None if rest is None else worst * 1e3
     if rest is None or worst < ex.motion.min_clearance:
-        why = ("no stable rest pose keeps the grasp axis horizontal" if rest is None else
-               f"on every stable rest pose the plan brings the gripper within {worst * 1e3:.1f} mm of the table")
-        return TrialOutcome(failure="unreachable", message=f"cannot execute on the table: {why}",
-                            plan_time_s=plan.plan_time_s, extra=info)
+        why = (
+            "no stable rest pose keeps the grasp axis horizontal"
+            if rest is None
+            else f"on every stable rest pose the plan brings the gripper within {worst * 1e3:.1f} mm of the table"
+        )
+        return TrialOutcome(
+            failure="unreachable",
+            message=f"cannot execute on the table: {why}",
+            plan_time_s=plan.plan_time_s,
+            extra=info,
+        )
     info["rest_pose"] = rest.as_array().tolist()
     rig = TableRig(ctx.backend, ctx.robot, model, ex, ctx.rng)
     rig.build(rest)
@@ -243,9 +308,14 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
         t_exec = ctx.backend.time
         corrections = []
         for k, (kind, poses) in enumerate(prims):
-            ctx.recorder.event("primitive", index=k, primitive=kind, waypoints=len(poses),
-                               object_pose=ctx.backend.get_pose(rig.body).as_array(),
-                               hand_in_object=rig.hand_in_object().as_array())
+            ctx.recorder.event(
+                "primitive",
+                index=k,
+                primitive=kind,
+                waypoints=len(poses),
+                object_pose=ctx.backend.get_pose(rig.body).as_array(),
+                hand_in_object=rig.hand_in_object().as_array(),
+            )
             rig.loosen()
             rig.follow(poses)
             if cfg.regrip_between_primitives:
@@ -253,8 +323,14 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
             if cfg.corrections > 0:
                 if not cfg.regrip_between_primitives:
                     rig.tighten()
-                corrections.append(rig.servo(poses[-1], cfg.correction_position, math.radians(cfg.correction_angle),
-                                             cfg.corrections))
+                corrections.append(
+                    rig.servo(
+                        poses[-1],
+                        cfg.correction_position,
+                        math.radians(cfg.correction_angle),
+                        cfg.corrections,
+                    )
+                )
         info["corrections"] = corrections
         if not cfg.regrip_between_primitives:
             rig.tighten()
@@ -263,8 +339,13 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
         hold = rig.lift_and_hold()
         contacts = None if hold.dropped else rig.pad_contacts_object()
     except RigFailure as e:
-        return TrialOutcome(failure=e.cause, dropped=e.cause == "dropped", message=str(e),
-                            plan_time_s=plan.plan_time_s, extra=info)
+        return TrialOutcome(
+            failure=e.cause,
+            dropped=e.cause == "dropped",
+            message=str(e),
+            plan_time_s=plan.plan_time_s,
+            extra=info,
+        )
     reached = rig.hand_in_object()
 
     def published(pose: Pose) -> np.ndarray:
@@ -277,12 +358,28 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
         reached_contacts = pl.to_published(ordered).tolist()
     if centroids is not None:
         info["contact_centroids"] = pl.to_published(centroids).tolist()
-    info.update(hold={"stable": hold.stable, "drift_mm": hold.drift_position * 1e3, "drift_deg": hold.drift_angle_deg,
-                                         "lift_slip_mm": hold.lift_slip_position * 1e3, "lift_slip_deg": hold.lift_slip_angle_deg},
-                planned_final=np.concatenate([pl.to_published(plan.final.position[None])[0],
-                                              pl.quat_to_published(plan.final.quaternion)]).tolist())
+    info.update(
+        hold={
+            "stable": hold.stable,
+            "drift_mm": hold.drift_position * 1e3,
+            "drift_deg": hold.drift_angle_deg,
+            "lift_slip_mm": hold.lift_slip_position * 1e3,
+            "lift_slip_deg": hold.lift_slip_angle_deg,
+        },
+        planned_final=np.concatenate(
+            [
+                pl.to_published(plan.final.position[None])[0],
+                pl.quat_to_published(plan.final.quaternion),
+            ]
+        ).tolist(),
+    )
     return TrialOutcome(
-        reached=None if hold.dropped else published(reached), setup=published(setup), dropped=hold.dropped,
-        plan_time_s=plan.plan_time_s, exec_time_s=exec_time, reached_contacts=reached_contacts,
-        message=hold.message, extra=info,
+        reached=None if hold.dropped else published(reached),
+        setup=published(setup),
+        dropped=hold.dropped,
+        plan_time_s=plan.plan_time_s,
+        exec_time_s=exec_time,
+        reached_contacts=reached_contacts,
+        message=hold.message,
+        extra=info,
     )

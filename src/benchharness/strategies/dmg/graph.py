@@ -216,7 +216,9 @@ def build_graph(mesh, config: DMGConfig | None = None) -> DMGraph:
     pt = discretise_surface(mesh, cfg.patch_size, cfg.patch_normal_angle)
     opposite, onormal, width = _opposite_contacts(mesh, pt)
     with np.errstate(invalid="ignore"):
-        antipodal = np.einsum("ij,ij->i", onormal, -pt.normals) >= np.cos(g.friction_cone_half_angle)
+        antipodal = np.einsum("ij,ij->i", onormal, -pt.normals) >= np.cos(
+            g.friction_cone_half_angle
+        )
         feasible = (
             np.isfinite(width)
             & (width >= g.min_opening)
@@ -230,7 +232,13 @@ def build_graph(mesh, config: DMGConfig | None = None) -> DMGraph:
         occ = Occupancy(mesh, cfg.occupancy_pitch)
         for chunk in np.array_split(fi, max(1, len(fi) // 256)):
             admissible[chunk] = _collision_free(
-                cfg, occ, pt.centers[chunk], pt.normals[chunk], opposite[chunk], pt.tangent1[chunk], pt.tangent2[chunk]
+                cfg,
+                occ,
+                pt.centers[chunk],
+                pt.normals[chunk],
+                opposite[chunk],
+                pt.tangent1[chunk],
+                pt.tangent2[chunk],
             )
     nodes = [DMGNode(int(p), run) for p in range(len(pt)) for run in _runs(admissible[p])]
 

@@ -89,6 +89,7 @@ def _spatula_rotation() -> tuple[tuple[float, float, float], ...]:
     r = ry @ np.diag([-1.0, -1.0, 1.0])  # 180 deg about z, then the tilt
     return tuple(tuple(float(v) for v in row) for row in r)
 
+
 PLACEMENTS: dict[str, Placement] = {
     "gelatin box": Placement(
         "gelatin box",
@@ -128,5 +129,7 @@ PLACEMENTS: dict[str, Placement] = {
 def placement_for(name: str) -> Placement:
     key = " ".join(str(name).lower().replace("_", " ").split())
     if key not in PLACEMENTS:
-        raise KeyError(f"no placement of the published data for {name!r}; known: {sorted(PLACEMENTS)}")
+        raise KeyError(
+            f"no placement of the published data for {name!r}; known: {sorted(PLACEMENTS)}"
+        )
     return PLACEMENTS[key]

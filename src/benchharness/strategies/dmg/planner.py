@@ -21,13 +21,24 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Literal, Union
+from typing import Literal
 
 import numpy as np
 
 from .graph import DMGraph
 
-__all__ = ["Grasp", "Rotate", "Translate", "Primitive", "SnappedGrasp", "Plan", "snap_grasp", "surface_contacts", "plan", "NoPlanError"]
+__all__ = [
+    "Grasp",
+    "Rotate",
+    "Translate",
+    "Primitive",
+    "SnappedGrasp",
+    "Plan",
+    "snap_grasp",
+    "surface_contacts",
+    "plan",
+    "NoPlanError",
+]
 
 
 class NoPlanError(RuntimeError):
@@ -78,7 +89,7 @@ class Translate:
     kind: Literal["translate"] = "translate"
 
 
-Primitive = Union[Rotate, Translate]
+Primitive = Rotate | Translate
 
 
 @dataclass(frozen=True)
@@ -182,7 +193,9 @@ def surface_contacts(mesh, contacts, z_axis) -> tuple[np.ndarray, int]:
     return pts, principal
 
 
-def snap_grasp(dmg: DMGraph, grasp: Grasp, principal: int | None = None, candidates: int = 12) -> SnappedGrasp:
+def snap_grasp(
+    dmg: DMGraph, grasp: Grasp, principal: int | None = None, candidates: int = 12
+) -> SnappedGrasp:
     """Place a grasp on the graph (see the module docstring).
 
     ``principal`` forces which contact is the principal finger (the goal uses
@@ -200,7 +213,9 @@ def snap_grasp(dmg: DMGraph, grasp: Grasp, principal: int | None = None, candida
     facing = pt.normals @ -zg >= 0.5
     usable = np.flatnonzero(dmg.admissible.any(axis=1) & facing)
     if len(usable) == 0:
-        raise NoPlanError("no admissible state faces the gripper (object too wide for the gripper?)")
+        raise NoPlanError(
+            "no admissible state faces the gripper (object too wide for the gripper?)"
+        )
     d = np.linalg.norm(pt.centers[usable] - p0, axis=1)
     order = np.argsort(d, kind="stable")[:candidates]
     step = np.deg2rad(dmg.config.angle_step)
@@ -227,7 +242,9 @@ def _final_grasp(dmg: DMGraph, patch: int, theta: float, principal: int) -> Gras
     return Grasp(contacts, _matrix_to_quat(dmg.gripper_axes(patch, theta)))
 
 
-def _primitives(dmg: DMGraph, states, theta_start: float, theta_end: float) -> tuple[Primitive, ...]:
+def _primitives(
+    dmg: DMGraph, states, theta_start: float, theta_end: float
+) -> tuple[Primitive, ...]:
     """Merge runs of rotation / translation edges into primitives.
 
     The start and end angles are exact (the grasp's own angle, the desired
@@ -260,7 +277,11 @@ def _primitives(dmg: DMGraph, states, theta_start: float, theta_end: float) -> t
         else:
             length = 0.0
             while j < last and pk[j + 1][0] != pk[j][0]:
-                length += float(np.linalg.norm(dmg.patches.centers[pk[j + 1][0]] - dmg.patches.centers[pk[j][0]]))
+                length += float(
+                    np.linalg.norm(
+                        dmg.patches.centers[pk[j + 1][0]] - dmg.patches.centers[pk[j][0]]
+                    )
+                )
                 j += 1
             out.append(Translate(tuple(p for p, _ in pk[i : j + 1]), length))
         i = j

@@ -28,8 +28,14 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["REGION_TASK_FILE", "derive_region_tasks", "write_region_tasks", "desired_region", "contact_errors",
-           "score_store"]
+__all__ = [
+    "REGION_TASK_FILE",
+    "derive_region_tasks",
+    "write_region_tasks",
+    "desired_region",
+    "contact_errors",
+    "score_store",
+]
 
 REGION_TASK_FILE = "level2_dmg_regions.csv"
 
@@ -41,7 +47,9 @@ def derive_region_tasks(level3_path: str | Path | None = None):
     from ...paths import tasks_dir
     from .runner import DESIRED_REGION_RADIUS
 
-    src = read_tasks(Path(level3_path) if level3_path else tasks_dir() / "inhand" / "level3_dmg_tasks.csv")
+    src = read_tasks(
+        Path(level3_path) if level3_path else tasks_dir() / "inhand" / "level3_dmg_tasks.csv"
+    )
     n = len(src)
     return TaskSet(
         task_id=np.array([f"{t}-region" for t in src.task_id], dtype=object),
@@ -89,22 +97,42 @@ def desired_region(mesh, desired_contacts: np.ndarray, radius: float) -> np.ndar
     return np.array(sorted(verts), dtype=np.int64)
 
 
-def contact_errors(obj: str, desired_contacts, reached_contacts, *, radius: float | None = None,
-                   pad_radius: float | None = None, planner=None, method: str = "heat") -> dict[str, float]:
+def contact_errors(
+    obj: str,
+    desired_contacts,
+    reached_contacts,
+    *,
+    radius: float | None = None,
+    pad_radius: float | None = None,
+    planner=None,
+    method: str = "heat",
+) -> dict[str, float]:
     """G_euc, G_geo, G_min (m) of one trial, all in the task frame (see the module docstring)."""
     from ...metrics.contact import contact_region_error
     from ...objects import contact_region
     from .runner import DESIRED_REGION_RADIUS, FINGER_PAD_RADIUS
 
     mesh = _mesh_in_task_frame(obj, planner)
-    region = desired_region(mesh, desired_contacts, DESIRED_REGION_RADIUS if radius is None else radius)
-    pads = [contact_region(mesh, np.asarray(c, float), FINGER_PAD_RADIUS if pad_radius is None else pad_radius,
-                           metric="geodesic").mesh for c in np.asarray(reached_contacts, float)]
+    region = desired_region(
+        mesh, desired_contacts, DESIRED_REGION_RADIUS if radius is None else radius
+    )
+    pads = [
+        contact_region(
+            mesh,
+            np.asarray(c, float),
+            FINGER_PAD_RADIUS if pad_radius is None else pad_radius,
+            metric="geodesic",
+        ).mesh
+        for c in np.asarray(reached_contacts, float)
+    ]
     err = contact_region_error(mesh, region, pads, method=method)
     return {"g_euc": float(err.euc), "g_geo": float(err.geo), "g_min": float(err.g_min)}
 
 
-def score_store(store: str | Path, task_names: tuple[str, ...] = ("inhand-level3-dmg", "inhand-level2-dmg-regions")) -> list[dict[str, Any]]:
+def score_store(
+    store: str | Path,
+    task_names: tuple[str, ...] = ("inhand-level3-dmg", "inhand-level2-dmg-regions"),
+) -> list[dict[str, Any]]:
     """Contact-region errors of every stored DMG trial of ``task_names`` with reached contacts.
 
     Returns one dict per trial: task, backend, trial index, task id,
@@ -120,8 +148,10 @@ def score_store(store: str | Path, task_names: tuple[str, ...] = ("inhand-level3
     out = []
     con = sqlite3.connect(str(store))
     try:
-        rows = con.execute("select task, backend, strategy, trial_index, status, outcome_json from trials "
-                           "order by task, backend, trial_index").fetchall()
+        rows = con.execute(
+            "select task, backend, strategy, trial_index, status, outcome_json from trials "
+            "order by task, backend, trial_index"
+        ).fetchall()
     finally:
         con.close()
     for task, backend, strategy, idx, status, oj in rows:
@@ -129,8 +159,15 @@ def score_store(store: str | Path, task_names: tuple[str, ...] = ("inhand-level3
             continue
         o = json.loads(oj or "{}")
         rc = o.get("reached_contacts")
-        row: dict[str, Any] = {"task": task, "backend": backend, "strategy": strategy, "trial": idx,
-                               "task_id": o.get("task_id"), "object": o.get("object"), "status": status}
+        row: dict[str, Any] = {
+            "task": task,
+            "backend": backend,
+            "strategy": strategy,
+            "trial": idx,
+            "task_id": o.get("task_id"),
+            "object": o.get("object"),
+            "status": status,
+        }
         if rc and status == "success":
             if task not in tasks:
                 ts = get_manager().create("task", task)
@@ -140,13 +177,19 @@ def score_store(store: str | Path, task_names: tuple[str, ...] = ("inhand-level3
     return out
 
 
-if __name__ == "__main__":  # python -m benchharness.strategies.dmg.regions [STORE]: write the task file, or score a store
+if (
+    __name__ == "__main__"
+):  # python -m benchharness.strategies.dmg.regions [STORE]: write the task file, or score a store
     import sys
 
     if len(sys.argv) > 1:
         for r in score_store(sys.argv[1]):
-            g = {k: (f"{r[k] * 100:.3f} cm" if k in r else "—") for k in ("g_euc", "g_geo", "g_min")}
-            print(f"{r['task']:28s} {r['backend']:9s} trial {r['trial']:2d} {r['task_id']:32s} {r['status']:9s} "
-                  f"G_euc {g['g_euc']}  G_geo {g['g_geo']}  G_min {g['g_min']}")
+            g = {
+                k: (f"{r[k] * 100:.3f} cm" if k in r else "—") for k in ("g_euc", "g_geo", "g_min")
+            }
+            print(
+                f"{r['task']:28s} {r['backend']:9s} trial {r['trial']:2d} {r['task_id']:32s} {r['status']:9s} "
+                f"G_euc {g['g_euc']}  G_geo {g['g_geo']}  G_min {g['g_min']}"
+            )
     else:
         print(write_region_tasks())

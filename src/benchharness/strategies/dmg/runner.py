@@ -9,9 +9,10 @@ results file and the desired region is written as its vertex indices.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,7 +22,17 @@ from .placement import Placement, placement_for
 if TYPE_CHECKING:  # the planner module pulls in scipy/trimesh at call time only
     from .planner import Plan
 
-__all__ = ["TaskPlan", "DMGPlanner", "ReachedGrasp", "results_for_grasps", "PUBLISHED_TASK_CONFIGS", "DESIRED_REGION_RADIUS", "FINGER_PAD_RADIUS", "results_from_plans", "write_dmg_results"]
+__all__ = [
+    "TaskPlan",
+    "DMGPlanner",
+    "ReachedGrasp",
+    "results_for_grasps",
+    "PUBLISHED_TASK_CONFIGS",
+    "DESIRED_REGION_RADIUS",
+    "FINGER_PAD_RADIUS",
+    "results_from_plans",
+    "write_dmg_results",
+]
 
 #: Per-object departures from the default config needed by the published tasks.
 #: The published cracker-box task grasps the box across its 60 mm (real scan:
@@ -50,7 +61,7 @@ class TaskPlan:
 
     task_id: str
     object: str
-    plan: "Plan"
+    plan: Plan
     final_contacts: np.ndarray
     final_quaternion: np.ndarray
     graph_time_s: float
@@ -77,7 +88,9 @@ class DMGPlanner:
     """
 
     config: DMGConfig = field(default_factory=DMGConfig)
-    object_configs: Mapping[str, DMGConfig] = field(default_factory=lambda: dict(PUBLISHED_TASK_CONFIGS))
+    object_configs: Mapping[str, DMGConfig] = field(
+        default_factory=lambda: dict(PUBLISHED_TASK_CONFIGS)
+    )
     resolution: float = 0.003
     meshes: Mapping[str, object] = field(default_factory=dict)
     #: execution on a simulator (``run_trial``): a :class:`.execution.DMGExecConfig`, None = defaults
@@ -118,7 +131,9 @@ class DMGPlanner:
             return placement_for(obj)
         except KeyError:
             ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-            return Placement(_key(obj), ident, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), "task assumed in our frame")
+            return Placement(
+                _key(obj), ident, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), "task assumed in our frame"
+            )
 
     def plan_task(self, tasks, i: int) -> TaskPlan:
         """Plan row ``i`` of a :class:`~benchharness.inhand.records.TaskSet`.
@@ -131,11 +146,17 @@ class DMGPlanner:
         for stage in ("initial", "desired"):
             c = tasks.contacts.get(stage)
             if c is None or c.shape[1] < 2 or not np.all(np.isfinite(c[i, :2])):
-                raise ValueError(f"task {tasks.task_id[i]!r}: the DMG needs two {stage} contact points")
+                raise ValueError(
+                    f"task {tasks.task_id[i]!r}: the DMG needs two {stage} contact points"
+                )
         pl = self.placement(obj)
         dmg = self.graph(obj)
-        ini = Grasp(pl.to_ours(tasks.contacts["initial"][i, :2]), pl.quat_to_ours(tasks.initial[i, 3:]))
-        des = Grasp(pl.to_ours(tasks.contacts["desired"][i, :2]), pl.quat_to_ours(tasks.desired[i, 3:]))
+        ini = Grasp(
+            pl.to_ours(tasks.contacts["initial"][i, :2]), pl.quat_to_ours(tasks.initial[i, 3:])
+        )
+        des = Grasp(
+            pl.to_ours(tasks.contacts["desired"][i, :2]), pl.quat_to_ours(tasks.desired[i, 3:])
+        )
         p = plan(dmg, ini, des)
         return TaskPlan(
             task_id=str(tasks.task_id[i]),
@@ -165,7 +186,9 @@ class ReachedGrasp:
     reached_goal: bool = True
 
 
-def results_for_grasps(tasks, grasps: list[ReachedGrasp], planner: DMGPlanner, out_dir: str | Path, method: str):
+def results_for_grasps(
+    tasks, grasps: list[ReachedGrasp], planner: DMGPlanner, out_dir: str | Path, method: str
+):
     """A :class:`ResultSet` for final grasps of ``tasks``; meshes go to ``out_dir/meshes``.
 
     One trial per task (the planner is deterministic). ``object_mesh`` is
@@ -196,7 +219,9 @@ def results_for_grasps(tasks, grasps: list[ReachedGrasp], planner: DMGPlanner, o
         verts: set[int] = set()
         z = _quat_to_matrix(tasks.desired[row, 3:])[:, 2]
         for c in surface_contacts(mesh, tasks.contacts["desired"][row, :2], z)[0]:
-            verts.update(contact_region(mesh, c, DESIRED_REGION_RADIUS, metric="geodesic").vertices.tolist())
+            verts.update(
+                contact_region(mesh, c, DESIRED_REGION_RADIUS, metric="geodesic").vertices.tolist()
+            )
         regions.append("vertices:" + ";".join(str(v) for v in sorted(verts)))
         names = []
         for k, c in enumerate(np.asarray(g.contacts, float)):
@@ -227,22 +252,44 @@ def results_for_grasps(tasks, grasps: list[ReachedGrasp], planner: DMGPlanner, o
         extra={
             "robot": np.array(["yumi"] * n, dtype=object),
             "dmg_time_s": np.array([f"{g.graph_time_s:.4g}" for g in grasps], dtype=object),
-            "reached_goal_node": np.array(["1" if g.reached_goal else "0" for g in grasps], dtype=object),
+            "reached_goal_node": np.array(
+                ["1" if g.reached_goal else "0" for g in grasps], dtype=object
+            ),
             "reached_links": np.array(pads, dtype=object),
         },
     )
 
 
-def results_from_plans(tasks, plans: list[TaskPlan], planner: DMGPlanner, out_dir: str | Path, method: str = "DMG (benchharness)"):
+def results_from_plans(
+    tasks,
+    plans: list[TaskPlan],
+    planner: DMGPlanner,
+    out_dir: str | Path,
+    method: str = "DMG (benchharness)",
+):
     """:func:`results_for_grasps` for our plans."""
     grasps = [
-        ReachedGrasp(p.task_id, p.object, p.final_contacts, p.final_pose, p.plan_time_s, p.graph_time_s, p.plan.reached_goal)
+        ReachedGrasp(
+            p.task_id,
+            p.object,
+            p.final_contacts,
+            p.final_pose,
+            p.plan_time_s,
+            p.graph_time_s,
+            p.plan.reached_goal,
+        )
         for p in plans
     ]
     return results_for_grasps(tasks, grasps, planner, out_dir, method)
 
 
-def write_dmg_results(tasks, plans: list[TaskPlan], planner: DMGPlanner, path: str | Path, method: str = "DMG (benchharness)") -> Path:
+def write_dmg_results(
+    tasks,
+    plans: list[TaskPlan],
+    planner: DMGPlanner,
+    path: str | Path,
+    method: str = "DMG (benchharness)",
+) -> Path:
     """Write the results file (and its meshes beside it); returns the path."""
     from benchharness.inhand.fileformat import write_results
 

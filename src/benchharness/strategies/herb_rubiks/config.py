@@ -117,5 +117,5 @@ class HerbPushGraspConfig:
     max_actions: int | None = None
     errors: ErrorConfig = ErrorConfig()
 
-    def zero_error(self) -> "HerbPushGraspConfig":
+    def zero_error(self) -> HerbPushGraspConfig:
         return replace(self, errors=self.errors.zero())

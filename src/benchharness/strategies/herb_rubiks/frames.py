@@ -22,9 +22,23 @@ from scipy.spatial.transform import Rotation
 from ...geometry import Pose
 from ..pr2_rubiks.frames import DIRECTIONS, grip_candidates, rotate_about_point
 
-__all__ = ["CUBE_HALF", "DIRECTIONS", "HERB_FROM_PR2", "PROX_CORNERS", "DIST_CORNERS", "approach_axis", "band_clear",
-           "finger_extent", "pinch_axis", "push_grip_candidates", "reanchor_along_approach", "rotate_about_point",
-           "rolled_about_approach", "thumb_face_depth", "thumb_tip_lateral"]
+__all__ = [
+    "CUBE_HALF",
+    "DIRECTIONS",
+    "HERB_FROM_PR2",
+    "PROX_CORNERS",
+    "DIST_CORNERS",
+    "approach_axis",
+    "band_clear",
+    "finger_extent",
+    "pinch_axis",
+    "push_grip_candidates",
+    "reanchor_along_approach",
+    "rotate_about_point",
+    "rolled_about_approach",
+    "thumb_face_depth",
+    "thumb_tip_lateral",
+]
 
 CUBE_HALF = 0.0285
 #: rotation PR2 tool frame -> HERB tool frame (columns: HERB axes in PR2 tool coordinates)
@@ -32,13 +46,25 @@ HERB_FROM_PR2 = Rotation.from_matrix(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0],
 #: BarrettHand distal link box (robots/descriptions/herb.py: 22 x 14 mm, 49 mm long, from 3 mm past
 #: the distal joint), corners in the link frame
 _DIST_LEN = 0.055
-_DIST_CORNERS = np.array([[sx * 0.011, sy * 0.007, 0.003 + sz] for sx in (-1, 1) for sy in (-1, 1)
-                          for sz in (0.0, _DIST_LEN - 0.006)])
+_DIST_CORNERS = np.array(
+    [
+        [sx * 0.011, sy * 0.007, 0.003 + sz]
+        for sx in (-1, 1)
+        for sy in (-1, 1)
+        for sz in (0.0, _DIST_LEN - 0.006)
+    ]
+)
 #: the same, public (distal links of any finger)
 DIST_CORNERS = _DIST_CORNERS
 #: BarrettHand proximal link box (24 x 16 mm, 58 mm long, centred 37 mm past the flex joint), link frame
-PROX_CORNERS = np.array([[sx * 0.012, sy * 0.008, 0.037 + sz * 0.029] for sx in (-1, 1) for sy in (-1, 1)
-                         for sz in (-1, 1)])
+PROX_CORNERS = np.array(
+    [
+        [sx * 0.012, sy * 0.008, 0.037 + sz * 0.029]
+        for sx in (-1, 1)
+        for sy in (-1, 1)
+        for sz in (-1, 1)
+    ]
+)
 
 
 def approach_axis(tool: Pose) -> np.ndarray:
@@ -52,8 +78,10 @@ def pinch_axis(tool: Pose) -> np.ndarray:
 
 def push_grip_candidates(cube: Pose, world_dir: str, face_depth: float) -> list[Pose]:
     """The four push-grasp tool frames on the face nearest ``world_dir`` (pinch across either face pair, either way)."""
-    return [Pose.from_rotation(p.p, p.rotation * HERB_FROM_PR2)
-            for p in grip_candidates(cube, world_dir, CUBE_HALF + face_depth)]
+    return [
+        Pose.from_rotation(p.p, p.rotation * HERB_FROM_PR2)
+        for p in grip_candidates(cube, world_dir, CUBE_HALF + face_depth)
+    ]
 
 
 def rolled_about_approach(tool: Pose, angle: float) -> Pose:
@@ -87,8 +115,9 @@ def thumb_tip_lateral(tool: Pose, distal: Pose) -> float:
     return float(np.mean(local[top, 1]))
 
 
-def finger_extent(tool_cmd: Pose, tool_measured: Pose, link_poses: list[tuple[Pose, np.ndarray]], frame: Pose
-                  ) -> tuple[np.ndarray, np.ndarray]:
+def finger_extent(
+    tool_cmd: Pose, tool_measured: Pose, link_poses: list[tuple[Pose, np.ndarray]], frame: Pose
+) -> tuple[np.ndarray, np.ndarray]:
     """Extent (min, max) in ``frame``'s coordinates of finger link boxes of a hand believed at ``tool_cmd``.
 
     ``link_poses`` are (measured link pose, box corners in the link frame)
@@ -106,8 +135,14 @@ def finger_extent(tool_cmd: Pose, tool_measured: Pose, link_poses: list[tuple[Po
     return loc.min(axis=0), loc.max(axis=0)
 
 
-def band_clear(lo: np.ndarray, hi: np.ndarray, lateral: float, half_width: float, reach: float,
-               clearance: float) -> bool:
+def band_clear(
+    lo: np.ndarray,
+    hi: np.ndarray,
+    lateral: float,
+    half_width: float,
+    reach: float,
+    clearance: float,
+) -> bool:
     """Whether a hand's closing outer fingers stay clear of an obstacle box (``lo``, ``hi``) in its tool frame.
 
     The closing fingers sweep, across the palm (tool y), ``lateral`` +-
@@ -121,7 +156,9 @@ def band_clear(lo: np.ndarray, hi: np.ndarray, lateral: float, half_width: float
     return bool(y_clear or z_clear)
 
 
-def reanchor_along_approach(belief: Pose, tool_at_contact: Pose, face_depth: float) -> tuple[Pose, float]:
+def reanchor_along_approach(
+    belief: Pose, tool_at_contact: Pose, face_depth: float
+) -> tuple[Pose, float]:
     """The belief moved along the approach so that its near face is where the thumb touched; and the shift (m).
 
     The push stopped when the thumb's tip, ``face_depth`` beyond the

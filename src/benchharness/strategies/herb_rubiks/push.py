@@ -19,8 +19,8 @@ joints), which is what the strategy can know.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -31,7 +31,16 @@ OUTER_FINGER_JOINTS = ("_bh_j12_joint", "_bh_j13_joint", "_bh_j22_joint", "_bh_j
 #: joint-name suffixes of the thumb (F3)
 THUMB_JOINTS = ("_bh_j32_joint", "_bh_j33_joint")
 
-__all__ = ["OUTER_FINGER_JOINTS", "THUMB_JOINTS", "PushResult", "PushUnreachable", "close_outer_fingers", "preshape", "push_until_contact", "wait_fingers"]
+__all__ = [
+    "OUTER_FINGER_JOINTS",
+    "THUMB_JOINTS",
+    "PushResult",
+    "PushUnreachable",
+    "close_outer_fingers",
+    "preshape",
+    "push_until_contact",
+    "wait_fingers",
+]
 
 
 class PushUnreachable(RuntimeError):
@@ -72,7 +81,9 @@ def contact_force(robot, hand, obj, links: set[str] | None = None) -> tuple[floa
     return total, tuple(sorted(hit))
 
 
-def preshape(hand, spread: float, thumb_flex: float, *, wait: float = 0.4, thumb_force: float = 2.0) -> None:
+def preshape(
+    hand, spread: float, thumb_flex: float, *, wait: float = 0.4, thumb_force: float = 2.0
+) -> None:
     """Open F1 and F2, set the spread, flex the thumb (F3) to ``thumb_flex`` rad: the probe."""
     u = np.array([spread, 0.0, 0.0, thumb_flex])
     f = np.asarray(hand.config.force_limit, dtype=float).copy()
@@ -106,8 +117,16 @@ def wait_fingers(hand, timeout: float, *, rest_speed: float = 0.02, min_time: fl
     return t
 
 
-def close_outer_fingers(hand, force_limit: float, *, speed: float = 1.5, timeout: float = 2.5,
-                        closed: float | None = None, stall: float = 0.12, centre: bool = True) -> float:
+def close_outer_fingers(
+    hand,
+    force_limit: float,
+    *,
+    speed: float = 1.5,
+    timeout: float = 2.5,
+    closed: float | None = None,
+    stall: float = 0.12,
+    centre: bool = True,
+) -> float:
     """Close F1 and F2 (facing each other at spread 90 deg), keeping the spread and the thumb.
 
     The command ramps at ``speed`` rad/s instead of jumping to "closed": a
@@ -206,8 +225,10 @@ def push_until_contact(
         res = arm.ik(targets[k][None], seed_q=qs[-1])
         jump = float(np.max(np.abs(res.q[0] - qs[-1])))
         if not bool(res.success[0]) or jump > max_joint_step:
-            raise PushUnreachable(f"no IK solution near the arm's branch at {1000 * d[k]:.0f} mm of the push "
-                                  f"(joint step {jump:.2f} rad)")
+            raise PushUnreachable(
+                f"no IK solution near the arm's branch at {1000 * d[k]:.0f} mm of the push "
+                f"(joint step {jump:.2f} rad)"
+            )
         qs.append(res.q[0])
     qs = np.asarray(qs)
     be = robot.backend
@@ -237,14 +258,18 @@ def push_until_contact(
         i = min(int(x), n - 1)
         frac = x - i
         q_ref = qs[i] + frac * (qs[i + 1] - qs[i])
-        qd_ref = (qs[i + 1] - qs[i]) * speed / waypoint_spacing if s < limit else np.zeros(len(joints))
+        qd_ref = (
+            (qs[i + 1] - qs[i]) * speed / waypoint_spacing if s < limit else np.zeros(len(joints))
+        )
         force, hit = contact_force(robot, hand, obj, links)
         if force >= force_threshold:
             q_hold = arm.positions()
             travel = measured_travel()
             robot.drive(joints, q_hold)
             robot.settle(0.1)
-            return PushResult(True, travel, Pose(start.p + travel * z, start.q), hit, force, be.time - t0)
+            return PushResult(
+                True, travel, Pose(start.p + travel * z, start.q), hit, force, be.time - t0
+            )
         robot.hold()  # every other arm/torso joint at its last target (public API), then this arm's reference
         robot.drive(joints, q_ref, qd_ref)
         robot.step(per)  # steps the backend and lets the hands re-aim their coupled joints

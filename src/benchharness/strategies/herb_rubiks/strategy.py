@@ -31,13 +31,43 @@ from scipy.spatial.transform import Rotation
 from ...backends.interface import Box
 from ...geometry import Pose
 from ...runner.contract import TrialContext, TrialOutcome
-from ..regrasp import HandModel, Handover, Pick, Regrasp, Release, Twist, execute, plan_sequence, twist_move
+from ..regrasp import (
+    HandModel,
+    Handover,
+    Pick,
+    Regrasp,
+    Release,
+    Twist,
+    execute,
+    plan_sequence,
+    twist_move,
+)
 from .config import HerbPushGraspConfig
-from .frames import (CUBE_HALF, DIST_CORNERS, DIRECTIONS, PROX_CORNERS, approach_axis, band_clear, finger_extent,
-                     pinch_axis, push_grip_candidates, reanchor_along_approach, rolled_about_approach,
-                     rotate_about_point, thumb_face_depth, thumb_tip_lateral)
-from .push import (OUTER_FINGER_JOINTS, PushUnreachable, _force_limits, close_outer_fingers, preshape,
-                   push_until_contact, wait_fingers)
+from .frames import (
+    CUBE_HALF,
+    DIRECTIONS,
+    DIST_CORNERS,
+    PROX_CORNERS,
+    approach_axis,
+    band_clear,
+    finger_extent,
+    pinch_axis,
+    push_grip_candidates,
+    reanchor_along_approach,
+    rolled_about_approach,
+    rotate_about_point,
+    thumb_face_depth,
+    thumb_tip_lateral,
+)
+from .push import (
+    OUTER_FINGER_JOINTS,
+    PushUnreachable,
+    _force_limits,
+    close_outer_fingers,
+    preshape,
+    push_until_contact,
+    wait_fingers,
+)
 
 __all__ = ["PushGraspStrategy", "StrategyFailure"]
 
@@ -83,9 +113,13 @@ class Hand:
     last_grip: Pose | None = None
     depth: int = 0
     shape: int = 0  #: depth of the current pre-shape (0: none yet)
-    face_depth: float = 0.0  #: thumb tip beyond the tool frame in the current pre-shape (m), measured
+    face_depth: float = (
+        0.0  #: thumb tip beyond the tool frame in the current pre-shape (m), measured
+    )
     slide: float = 0.0  #: how far the current grip slid across its face off the nominal, to clear the other hand (m)
-    thumb_lateral: float = 0.0  #: where across the palm (tool y, m) the thumb's tip touches, measured
+    thumb_lateral: float = (
+        0.0  #: where across the palm (tool y, m) the thumb's tip touches, measured
+    )
     log: list = field(default_factory=list)
 
 
@@ -104,19 +138,29 @@ class PushGraspStrategy:
         from ...cube_physics import PhysicalCube
 
         if getattr(ctx.robot, "name", None) != self.robot:
-            raise ValueError(f"strategy {self.name!r} drives HERB's BarrettHands (robot 'herb'); "
-                             f"got robot {getattr(ctx.robot, 'name', ctx.robot)!r}. "
-                             "Use dead-reckoning or sensor-aided for the PR2.")
+            raise ValueError(
+                f"strategy {self.name!r} drives HERB's BarrettHands (robot 'herb'); "
+                f"got robot {getattr(ctx.robot, 'name', ctx.robot)!r}. "
+                "Use dead-reckoning or sensor-aided for the PR2."
+            )
         cfg = self.config
         b = ctx.backend
         self.ctx, self.b = ctx, b
         b.add_ground()
         h = cfg.table_height
         tx, ty = cfg.table_half_size
-        b.add_body([Box((tx, ty, h / 2))], Pose([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]), 1.0, fixed=True, name="table")
+        b.add_body(
+            [Box((tx, ty, h / 2))],
+            Pose([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]),
+            1.0,
+            fixed=True,
+            name="table",
+        )
         # protocol: top face up, F facing the robot (body -y -> world -x: yaw -90 deg)
-        true0 = Pose.from_rotation([cfg.cube_xy[0], cfg.cube_xy[1], h + CUBE_HALF + 5e-4],
-                                   Rotation.from_euler("z", -90, degrees=True))
+        true0 = Pose.from_rotation(
+            [cfg.cube_xy[0], cfg.cube_xy[1], h + CUBE_HALF + 5e-4],
+            Rotation.from_euler("z", -90, degrees=True),
+        )
         self.cube = cube = PhysicalCube(b, true0)
         self.robot = ctx.robot
         self.robot.spawn(b)
@@ -138,9 +182,17 @@ class PushGraspStrategy:
         self.hands: dict[str, Hand] = {}
         for side in ("left", "right"):
             dp = rng.normal(0.0, err.calib_pos_std, 3) if err.calib_pos_std else np.zeros(3)
-            dr = rng.normal(0.0, math.radians(err.calib_rot_std_deg), 3) if err.calib_rot_std_deg else np.zeros(3)
-            self.hands[side] = Hand(side, self.robot.arm(f"{side}_arm"), self.robot.hand(f"{side}_hand"),
-                                    Pose.from_rotation(dp, Rotation.from_rotvec(dr)))
+            dr = (
+                rng.normal(0.0, math.radians(err.calib_rot_std_deg), 3)
+                if err.calib_rot_std_deg
+                else np.zeros(3)
+            )
+            self.hands[side] = Hand(
+                side,
+                self.robot.arm(f"{side}_arm"),
+                self.robot.hand(f"{side}_hand"),
+                Pose.from_rotation(dp, Rotation.from_rotvec(dr)),
+            )
         for hnd in self.hands.values():
             hnd.cmd = hnd.arm.tcp_pose()
         self.robot.settle(0.2)
@@ -150,8 +202,14 @@ class PushGraspStrategy:
         model = replace(HandModel.herb(), pick_approaches=("side",))
         plan = plan_sequence(ctx.item.sequence, model)
         trace = execute(plan).orientations
-        rec.event("plan", actions=len(plan.actions), twists=plan.twists, regrasps=plan.regrasps,
-                  handovers=plan.handovers, text=plan.describe())
+        rec.event(
+            "plan",
+            actions=len(plan.actions),
+            twists=plan.twists,
+            regrasps=plan.regrasps,
+            handovers=plan.handovers,
+            text=plan.describe(),
+        )
         self.plan, self.trace = plan, trace
         self.t_release = None
         move_index = 0
@@ -177,20 +235,36 @@ class PushGraspStrategy:
                 if not isinstance(action, Release):
                     self._check_drop(k)
                     # after the release nothing believes where the cube lies (see pr2_rubiks)
-                    rec.pose_estimate(move_index, self.cube.pose(), self.est, label=type(action).__name__.lower())
+                    rec.pose_estimate(
+                        move_index, self.cube.pose(), self.est, label=type(action).__name__.lower()
+                    )
         except StrategyFailure as e:
             rec.event("failure", cause=e.cause, message=str(e))
             if e.cause is None:
-                return TrialOutcome(final_state=self.cube.state_string, termination_s=b.time, message=str(e),
-                                    extra=self._extra())
-            return TrialOutcome(failure=e.cause, message=str(e), termination_s=b.time, final_state=None,
-                                extra=self._extra())
+                return TrialOutcome(
+                    final_state=self.cube.state_string,
+                    termination_s=b.time,
+                    message=str(e),
+                    extra=self._extra(),
+                )
+            return TrialOutcome(
+                failure=e.cause,
+                message=str(e),
+                termination_s=b.time,
+                final_state=None,
+                extra=self._extra(),
+            )
         t_end = self.t_release if self.t_release is not None else b.time
-        return TrialOutcome(final_state=self.cube.state_string, termination_s=t_end, extra=self._extra())
+        return TrialOutcome(
+            final_state=self.cube.state_string, termination_s=t_end, extra=self._extra()
+        )
 
     def _extra(self) -> dict:
-        return {"twists": [o.summary() for o in self.cube.history], "misaligned": self.cube.misaligned,
-                "errors": {s: h.calibration.as_array().tolist() for s, h in self.hands.items()}}
+        return {
+            "twists": [o.summary() for o in self.cube.history],
+            "misaligned": self.cube.misaligned,
+            "errors": {s: h.calibration.as_array().tolist() for s, h in self.hands.items()},
+        }
 
     # ------------------------------------------------------------- sensing
     def _camera_estimate(self, ctx: TrialContext) -> Pose:
@@ -203,7 +277,9 @@ class PushGraspStrategy:
             from ...sensors import HeadCamera
         except ImportError:  # sensors package absent: a documented Gaussian from ctx.rng
             p = true.p + ctx.rng.normal(0.0, err.camera_pos_std, 3)
-            yaw = Rotation.from_euler("z", ctx.rng.normal(0.0, err.camera_yaw_std_deg), degrees=True)
+            yaw = Rotation.from_euler(
+                "z", ctx.rng.normal(0.0, err.camera_yaw_std_deg), degrees=True
+            )
             return Pose.from_rotation(p, yaw * true.rotation)
         cam = slot.create() if slot is not None else HeadCamera()
         rng = slot.rng if slot is not None else ctx.rng
@@ -212,9 +288,13 @@ class PushGraspStrategy:
     def _check_drop(self, k: int) -> None:
         """Judge's check (not control): the cube far from where it is believed and below the hands."""
         true = self.cube.pose()
-        if (true.p[2] < self.config.table_height + CUBE_HALF + 0.01
-                and np.linalg.norm(true.p - self.est.p) > self.config.drop_distance):
-            raise StrategyFailure("dropped", f"action {k + 1}: the cube fell (at {np.round(true.p, 3).tolist()})")
+        if (
+            true.p[2] < self.config.table_height + CUBE_HALF + 0.01
+            and np.linalg.norm(true.p - self.est.p) > self.config.drop_distance
+        ):
+            raise StrategyFailure(
+                "dropped", f"action {k + 1}: the cube fell (at {np.round(true.p, 3).tolist()})"
+            )
 
     # ------------------------------------------------------------- motion
     def _actual(self, hand: Hand, target: Pose, noise: np.ndarray) -> Pose:
@@ -225,20 +305,37 @@ class PushGraspStrategy:
         s = self.config.errors.tracking_std
         return self.ctx.rng.normal(0.0, s, 3) if s else np.zeros(3)
 
-    def _send(self, hand: Hand, target: Pose, *, label: str, duration: float | None = None,
-              settle: float = 0.2) -> None:
+    def _send(
+        self,
+        hand: Hand,
+        target: Pose,
+        *,
+        label: str,
+        duration: float | None = None,
+        settle: float = 0.2,
+    ) -> None:
         """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors."""
-        res = hand.arm.move_to_pose(self._actual(hand, target, self._noise()), duration=duration,
-                                    velocity_scale=self.config.velocity_scale, settle=settle)
+        res = hand.arm.move_to_pose(
+            self._actual(hand, target, self._noise()),
+            duration=duration,
+            velocity_scale=self.config.velocity_scale,
+            settle=settle,
+        )
         hand.cmd = target
         if hand.holding:
             hand.last_grip = target
         if res.ik_success and res.pos_error > self.config.reach_warning:
-            self.ctx.recorder.event("warning", message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
-                                    f"its {label} target (joint error {res.final_joint_error:.3f} rad)")
+            self.ctx.recorder.event(
+                "warning",
+                message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
+                f"its {label} target (joint error {res.final_joint_error:.3f} rad)",
+            )
         if not res.ik_success:
-            raise StrategyFailure("unreachable", f"{hand.side} arm: no IK solution for {label} "
-                                  f"(target {np.round(target.p, 3).tolist()})")
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: no IK solution for {label} "
+                f"(target {np.round(target.p, 3).tolist()})",
+            )
         if hand.holding and not self._other(hand).holding and hand.cube_in_tcp is not None:
             self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
 
@@ -257,9 +354,16 @@ class PushGraspStrategy:
         hand.thumb_lateral = thumb_tip_lateral(hand.arm.tcp_pose(), distal)
         hand.shape = depth
 
-    def _choose_grip(self, hand: Hand, world_dir: str, twist_delta: float = 0.0, horizontal_pinch: bool = False,
-                     turn: tuple[str, float] | None = None, perpendicular: bool = False,
-                     parallel: bool = False) -> Pose:
+    def _choose_grip(
+        self,
+        hand: Hand,
+        world_dir: str,
+        twist_delta: float = 0.0,
+        horizontal_pinch: bool = False,
+        turn: tuple[str, float] | None = None,
+        perpendicular: bool = False,
+        parallel: bool = False,
+    ) -> Pose:
         """The push-grasp frame (of four finger placements) the arm reaches, with wrist-roll room for the next twist.
 
         ``perpendicular``: the outer fingers must cross the other hand's (the two grips overlap in
@@ -272,19 +376,27 @@ class PushGraspStrategy:
         other = self._other(hand)
         other_x = pinch_axis(other.last_grip) if other.holding and other.last_grip else None
         other_z = approach_axis(other.last_grip) if other.holding and other.last_grip else None
-        other_on_axis = other_x is not None and abs(float(np.dot(other_x, DIRECTIONS[world_dir]))) > 0.7
+        other_on_axis = (
+            other_x is not None and abs(float(np.dot(other_x, DIRECTIONS[world_dir]))) > 0.7
+        )
         base = hand.arm.base_pose()
         q_now = hand.arm.positions()
         lo, hi = hand.arm.lower[-1], hand.arm.upper[-1]
         best, best_score, fallback, fallback_score = None, -np.inf, None, -np.inf
         best_slide = fallback_slide = 0.0
-        tried: list[str] = []  # diagnostic for the recorder: each candidate and why it was taken or not
-        lateral = self.config.rotator_thumb_offset if hand.shape == 1 else self.config.holder_thumb_offset
+        tried: list[
+            str
+        ] = []  # diagnostic for the recorder: each candidate and why it was taken or not
+        lateral = (
+            self.config.rotator_thumb_offset if hand.shape == 1 else self.config.holder_thumb_offset
+        )
         for pose in push_grip_candidates(self.est, world_dir, hand.face_depth):
             fx = pinch_axis(pose)
             tag = f"pinch {_axis_name(fx)} thumb {_axis_name(pose.rotation.apply([0.0, 1.0, 0.0]))}"
             shift = lateral
-            if other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7:  # both hands on the same faces
+            if (
+                other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7
+            ):  # both hands on the same faces
                 shift = self._clear_lateral(hand, pose, lateral)
                 if shift is None:
                     tried.append(f"{tag}: fingers cannot clear the other hand's")
@@ -292,7 +404,9 @@ class PushGraspStrategy:
                 if abs(shift - lateral) > 1e-4:
                     tag += f" slid {1000 * (shift - lateral):+.0f} mm"
             pose = Pose(pose.p + pose.rotation.apply([0.0, shift, 0.0]), pose.q)
-            if horizontal_pinch and (abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7):
+            if horizontal_pinch and (
+                abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7
+            ):
                 continue  # on the table: no outer finger under the cube, and the thumb's root below (its tip
                 # curls up onto the face, clear of the table top)
             crossing = other_x is None or abs(float(np.dot(fx, other_x))) < 0.3
@@ -325,26 +439,43 @@ class PushGraspStrategy:
                 # away from the taker (a preference: with the root on the taker's side, the giver's fingers,
                 # 12 mm off centre towards the root, are where the taker's fingertips close)
                 taker_dir = DIRECTIONS[SIDE_DIR[other.side]]
-                if float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir)) > -0.7:
+                if (
+                    float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir))
+                    > -0.7
+                ):
                     score -= 1.0
                 if score > fallback_score:
                     fallback, fallback_score, fallback_slide = pose, score, shift - lateral
                 travel = self._turn_travel(hand, base, pose, res.q[0], *turn)
                 if travel is None:
-                    tried.append(f"{tag}: turn not smooth (score {score:.2f}; {getattr(self, '_turn_why', '')})")
+                    tried.append(
+                        f"{tag}: turn not smooth (score {score:.2f}; {getattr(self, '_turn_why', '')})"
+                    )
                     continue
                 score -= 0.1 * travel
-            tried.append(f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})")
+            tried.append(
+                f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})"
+            )
             if score > best_score:
                 best, best_score, best_slide = pose, score, shift - lateral
         if best is None and fallback is not None:
-            self.ctx.recorder.event("warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly")
+            self.ctx.recorder.event(
+                "warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly"
+            )
             best, best_slide = fallback, fallback_slide
-        self.ctx.recorder.event("grip_choice", hand=hand.side, face=world_dir, candidates=tried,
-                                chosen=None if best is None else
-                                f"pinch {_axis_name(pinch_axis(best))} thumb {_axis_name(best.rotation.apply([0.0, 1.0, 0.0]))}")
+        self.ctx.recorder.event(
+            "grip_choice",
+            hand=hand.side,
+            face=world_dir,
+            candidates=tried,
+            chosen=None
+            if best is None
+            else f"pinch {_axis_name(pinch_axis(best))} thumb {_axis_name(best.rotation.apply([0.0, 1.0, 0.0]))}",
+        )
         if best is None:
-            raise StrategyFailure("unreachable", f"{hand.side} arm: no push-grasp from {world_dir} reachable")
+            raise StrategyFailure(
+                "unreachable", f"{hand.side} arm: no push-grasp from {world_dir} reachable"
+            )
         hand.slide = best_slide
         return best
 
@@ -361,20 +492,33 @@ class PushGraspStrategy:
         cfg = self.config
         other = self._other(hand)
         prefix = other.arm.config.tcp_link.split("_")[0] + "_bh_finger_"
-        links = [(self.b.get_link_pose(self.robot.body, f"{prefix}{f}{n}_link"), PROX_CORNERS if n == 2 else DIST_CORNERS)
-                 for f in (1, 2) for n in (2, 3)]
+        links = [
+            (
+                self.b.get_link_pose(self.robot.body, f"{prefix}{f}{n}_link"),
+                PROX_CORNERS if n == 2 else DIST_CORNERS,
+            )
+            for f in (1, 2)
+            for n in (2, 3)
+        ]
         lo, hi = finger_extent(other.cmd, other.arm.tcp_pose(), links, face_pose)
 
         def ok(t: float) -> bool:
-            return (abs(t + hand.thumb_lateral) <= CUBE_HALF - cfg.thumb_edge_margin
-                    and band_clear(lo, hi, t, cfg.finger_half_width, cfg.finger_reach, cfg.handover_clearance))
+            return abs(t + hand.thumb_lateral) <= CUBE_HALF - cfg.thumb_edge_margin and band_clear(
+                lo, hi, t, cfg.finger_half_width, cfg.finger_reach, cfg.handover_clearance
+            )
 
         if ok(nominal):
             return nominal
-        feasible = [float(t) for t in np.arange(-cfg.max_lateral, cfg.max_lateral + 1e-9, 0.001) if ok(float(t))]
+        feasible = [
+            float(t)
+            for t in np.arange(-cfg.max_lateral, cfg.max_lateral + 1e-9, 0.001)
+            if ok(float(t))
+        ]
         return min(feasible, key=lambda t: abs(t - nominal)) if feasible else None
 
-    def _turn_travel(self, hand: Hand, base: Pose, grip: Pose, q: np.ndarray, axis: str, angle: float) -> float | None:
+    def _turn_travel(
+        self, hand: Hand, base: Pose, grip: Pose, q: np.ndarray, axis: str, angle: float
+    ) -> float | None:
         n = max(1, self.config.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
         total = 0.0
         for i in range(1, n + 1):
@@ -383,15 +527,27 @@ class PushGraspStrategy:
             jump = float(np.max(np.abs(res.q[0] - q)))
             if not res.success[0] or jump > self.config.max_waypoint_jump:
                 # diagnostic for the grip_choice event
-                self._turn_why = f"waypoint {i}/{n}: IK {bool(res.success[0])}, joint step {jump:.2f} rad"
+                self._turn_why = (
+                    f"waypoint {i}/{n}: IK {bool(res.success[0])}, joint step {jump:.2f} rad"
+                )
                 return None
             total += jump
             q = res.q[0]
         return total
 
-    def _push_grasp(self, hand: Hand, world_dir: str, depth: int, label: str, twist_delta: float = 0.0,
-                    horizontal_pinch: bool = False, k: int | None = None, perpendicular: bool = False,
-                    parallel: bool = False, before_close=None) -> None:
+    def _push_grasp(
+        self,
+        hand: Hand,
+        world_dir: str,
+        depth: int,
+        label: str,
+        twist_delta: float = 0.0,
+        horizontal_pinch: bool = False,
+        k: int | None = None,
+        perpendicular: bool = False,
+        parallel: bool = False,
+        before_close=None,
+    ) -> None:
         """Pre-shape, swing to the stand-off, push along the face normal until the thumb touches, close F1/F2.
 
         On contact the belief is re-anchored along the approach: the face is
@@ -403,46 +559,77 @@ class PushGraspStrategy:
         if hand.shape != depth:
             self._preshape(hand, depth)
         turn = self._next_turn(k, hand.side) if (k is not None and depth == 2) else None
-        grip = self._choose_grip(hand, world_dir, twist_delta, horizontal_pinch, turn, perpendicular, parallel)
+        grip = self._choose_grip(
+            hand, world_dir, twist_delta, horizontal_pinch, turn, perpendicular, parallel
+        )
         z = approach_axis(grip)
         far = Pose(grip.p - cfg.far_distance * z, grip.q)
-        if self._other(hand).holding and not hand.holding and \
-                np.linalg.norm(hand.cmd.p - self.est.p) < cfg.swing_radius:
+        if (
+            self._other(hand).holding
+            and not hand.holding
+            and np.linalg.norm(hand.cmd.p - self.est.p) < cfg.swing_radius
+        ):
             self._swing_round(hand, far, label)
-        if np.linalg.norm(far.p - hand.cmd.p) > 0.01 or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999:
+        if (
+            np.linalg.norm(far.p - hand.cmd.p) > 0.01
+            or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999
+        ):
             self._send(hand, far, label=f"{label} stand-off", settle=0.05)
         start = Pose(grip.p - cfg.push_start * z, grip.q)
         self._send(hand, start, label=f"{label} push start", settle=0.1)
         noise = self._noise()
         try:
-            res = push_until_contact(self.robot, hand.arm, hand.gripper, self.cube.body, start,
-                                     send_offset=lambda p: self._actual(hand, p, noise),
-                                     limit=cfg.push_start + cfg.push_limit, speed=cfg.approach_speed,
-                                     force_threshold=cfg.contact_force)
+            res = push_until_contact(
+                self.robot,
+                hand.arm,
+                hand.gripper,
+                self.cube.body,
+                start,
+                send_offset=lambda p: self._actual(hand, p, noise),
+                limit=cfg.push_start + cfg.push_limit,
+                speed=cfg.approach_speed,
+                force_threshold=cfg.contact_force,
+            )
         except PushUnreachable as e:
             raise StrategyFailure("unreachable", f"{label}: {hand.side} arm: {e}") from None
         hand.cmd = res.commanded
         if not res.contact:
-            raise StrategyFailure(None, f"{label}: {hand.side} push-grasp met no face within "
-                                  f"{1000 * (cfg.push_start + cfg.push_limit):.0f} mm (cube not where believed)")
+            raise StrategyFailure(
+                None,
+                f"{label}: {hand.side} push-grasp met no face within "
+                f"{1000 * (cfg.push_start + cfg.push_limit):.0f} mm (cube not where believed)",
+            )
         if not any(l.endswith(("_bh_finger_32_link", "_bh_finger_33_link")) for l in res.links):
-            raise StrategyFailure(None, f"{label}: {hand.side} push stopped on {list(res.links)}, not the thumb "
-                                  "(the cube is off to the side of where it is believed)")
+            raise StrategyFailure(
+                None,
+                f"{label}: {hand.side} push stopped on {list(res.links)}, not the thumb "
+                "(the cube is off to the side of where it is believed)",
+            )
         # re-anchor the belief along the approach: the face is at the thumb's tip
         self.est, corr = reanchor_along_approach(self.est, res.commanded, hand.face_depth)
         for h in self.hands.values():
             if h.holding and h.cmd is not None:
                 h.cube_in_tcp = h.cmd.inv() * self.est
         true = self.cube.pose()
-        rec.event("push", hand=hand.side, label=label, depth=depth, travel_mm=1000 * res.travel,
-                  correction_mm=1000 * corr, links=list(res.links), force=res.force,
-                  true_error_along_approach_mm=1000 * float(np.dot(true.p - self.est.p, z)))
+        rec.event(
+            "push",
+            hand=hand.side,
+            label=label,
+            depth=depth,
+            travel_mm=1000 * res.travel,
+            correction_mm=1000 * corr,
+            links=list(res.links),
+            force=res.force,
+            true_error_along_approach_mm=1000 * float(np.dot(true.p - self.est.p, z)),
+        )
         rec.pose_estimate(getattr(self, "_move_index", 0), true, self.est, label="push")
         if before_close is not None:
             before_close()
         close_outer_fingers(hand.gripper, cfg.grip_torque, speed=cfg.finger_speed)
         if not self._outer_touching(hand):
-            raise StrategyFailure(None, f"{label}: {hand.side} outer fingers closed on nothing (grasp missed)")
+            raise StrategyFailure(
+                None, f"{label}: {hand.side} outer fingers closed on nothing (grasp missed)"
+            )
         hand.holding = True
         hand.last_grip = hand.cmd
         hand.cube_in_tcp = hand.cmd.inv() * self.est
@@ -468,7 +655,10 @@ class PushGraspStrategy:
         start = hand.cmd
         r0, r1 = float(np.linalg.norm(start.p - c)), float(np.linalg.norm(far.p - c))
         u0, u1 = (start.p - c) / r0, (far.p - c) / r1
-        if math.degrees(math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))) < 2 * self.config.swing_step_deg:
+        if (
+            math.degrees(math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0))))
+            < 2 * self.config.swing_step_deg
+        ):
             return
         up = np.array([0.0, 0.0, 1.0])
         routes: list[tuple[list, list]] = [([u0, u1], [start.rotation, far.rotation])]
@@ -481,8 +671,16 @@ class PushGraspStrategy:
             via = via / np.linalg.norm(via)
             top = _turn_between(u0, via) * start.rotation
             for roll in (0.0, math.pi / 2, -math.pi / 2, math.pi):
-                routes.append(([u0, via, u1], [start.rotation, top * Rotation.from_rotvec([0.0, 0.0, roll]),
-                                               far.rotation]))
+                routes.append(
+                    (
+                        [u0, via, u1],
+                        [
+                            start.rotation,
+                            top * Rotation.from_rotvec([0.0, 0.0, roll]),
+                            far.rotation,
+                        ],
+                    )
+                )
         base = hand.arm.base_pose()
         why = ""
         for dirs, rots in routes:
@@ -492,19 +690,25 @@ class PushGraspStrategy:
                 res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q)
                 step = float(np.max(np.abs(res.q[0] - q)))
                 if not res.success[0] or step > self.config.swing_max_joint_step:
-                    why += (f" {len(dirs) - 1}-leg arc: waypoint {np.round(pose.p, 3).tolist()} IK "
-                            f"{bool(res.success[0])}, joint step {step:.2f} rad;")
+                    why += (
+                        f" {len(dirs) - 1}-leg arc: waypoint {np.round(pose.p, 3).tolist()} IK "
+                        f"{bool(res.success[0])}, joint step {step:.2f} rad;"
+                    )
                     ok = False
                     break
                 q = res.q[0]
             if ok:
-                self.ctx.recorder.event("swing", hand=hand.side, label=label, legs=len(dirs) - 1,
-                                        waypoints=len(poses))
+                self.ctx.recorder.event(
+                    "swing", hand=hand.side, label=label, legs=len(dirs) - 1, waypoints=len(poses)
+                )
                 for pose in poses:
                     self._send(hand, pose, label=f"{label} swing", settle=0.0)
                 return
-        self.ctx.recorder.event("warning", message=f"{hand.side}: {label}: no arc round the cube on the arm's "
-                                f"branch ({why.strip()}); one joint-space move to the stand-off")
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: {label}: no arc round the cube on the arm's "
+            f"branch ({why.strip()}); one joint-space move to the stand-off",
+        )
 
     def _arc(self, c: np.ndarray, dirs: list, rots: list, r0: float, r1: float) -> list[Pose]:
         """Waypoints (tool poses) on great-circle legs through the unit directions ``dirs`` from ``c``.
@@ -515,7 +719,9 @@ class PushGraspStrategy:
         """
         from scipy.spatial.transform import Slerp
 
-        angles = [math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0))) for a, b in zip(dirs[:-1], dirs[1:])]
+        angles = [
+            math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0))) for a, b in zip(dirs[:-1], dirs[1:])
+        ]
         total = sum(angles)
         step = math.radians(self.config.swing_step_deg)
         out, done = [], 0.0
@@ -537,13 +743,20 @@ class PushGraspStrategy:
         out: dict[str, list[int]] = {}
         for side, h in self.hands.items():
             prefix = h.arm.config.tcp_link.split("_")[0] + "_bh_"
-            slabs = {self.cube.layer_of(c.position, body_axis) for c in self.b.contacts(self.robot.body, self.cube.body)
-                     if c.link_a and c.link_a.startswith(prefix) and c.normal_force > 0.1}
+            slabs = {
+                self.cube.layer_of(c.position, body_axis)
+                for c in self.b.contacts(self.robot.body, self.cube.body)
+                if c.link_a and c.link_a.startswith(prefix) and c.normal_force > 0.1
+            }
             out[side] = sorted(slabs)
         return out
 
     def _outer_touching(self, hand: Hand) -> bool:
-        links = {self.robot.urdf_joints[j].child for j in hand.gripper.joints if j.endswith(OUTER_FINGER_JOINTS)}
+        links = {
+            self.robot.urdf_joints[j].child
+            for j in hand.gripper.joints
+            if j.endswith(OUTER_FINGER_JOINTS)
+        }
         return any(c.link_a in links for c in self.b.contacts(self.robot.body, self.cube.body))
 
     def _open_outer(self, hand: Hand, wait: float = 0.3) -> None:
@@ -585,17 +798,20 @@ class PushGraspStrategy:
             except StrategyFailure:
                 if frac < 1.0:
                     raise
-                self.ctx.recorder.event("warning", message=f"{hand.side}: retreat of {1000 * d:.0f} mm "
-                                        "unreachable, retreating half as far")
+                self.ctx.recorder.event(
+                    "warning",
+                    message=f"{hand.side}: retreat of {1000 * d:.0f} mm "
+                    "unreachable, retreating half as far",
+                )
 
     def _next_twist_delta(self, k: int, side: str) -> float:
-        for a in self.plan.actions[k + 1:]:
+        for a in self.plan.actions[k + 1 :]:
             if isinstance(a, Twist):
                 return self._roll_delta(a) if a.gripper == side else 0.0
         return 0.0
 
     def _next_turn(self, k: int, side: str) -> tuple[str, float] | None:
-        for a in self.plan.actions[k + 1:]:
+        for a in self.plan.actions[k + 1 :]:
             if isinstance(a, Handover):
                 return (a.axis, a.quarter_turns * math.pi / 2) if a.giver == side else None
             if isinstance(a, Regrasp):
@@ -611,19 +827,35 @@ class PushGraspStrategy:
     # ------------------------------------------------------------- actions
     def _pick(self, a: Pick, k: int) -> None:
         if a.approach != "side":
-            raise StrategyFailure(None, f"pick approach {a.approach!r} is not implemented (side only)")
+            raise StrategyFailure(
+                None, f"pick approach {a.approach!r} is not implemented (side only)"
+            )
         cfg = self.config
         picker = self.hands[a.gripper]
         other = self._other(picker)
         depth = 1 if a.rotator == a.gripper else 2
-        self._push_grasp(picker, SIDE_DIR[picker.side], depth, "pick",
-                         self._next_twist_delta(k, picker.side) if depth == 1 else 0.0, horizontal_pinch=True)
+        self._push_grasp(
+            picker,
+            SIDE_DIR[picker.side],
+            depth,
+            "pick",
+            self._next_twist_delta(k, picker.side) if depth == 1 else 0.0,
+            horizontal_pinch=True,
+        )
         lift = np.asarray(cfg.twist_position) - self.est.p
         self._send(picker, Pose(picker.cmd.p + [0, 0, lift[2] + 0.03], picker.cmd.q), label="lift")
-        self._send(picker, Pose(picker.cmd.p + [lift[0], lift[1], -0.03], picker.cmd.q), label="carry")
+        self._send(
+            picker, Pose(picker.cmd.p + [lift[0], lift[1], -0.03], picker.cmd.q), label="carry"
+        )
         odepth = 3 - depth
-        self._push_grasp(other, SIDE_DIR[other.side], odepth, "second grasp",
-                         self._next_twist_delta(k, other.side) if odepth == 1 else 0.0, k=k)
+        self._push_grasp(
+            other,
+            SIDE_DIR[other.side],
+            odepth,
+            "second grasp",
+            self._next_twist_delta(k, other.side) if odepth == 1 else 0.0,
+            k=k,
+        )
 
     def _twist(self, t: Twist, orientation, k: int) -> None:
         cube, rec = self.cube, self.ctx.recorder
@@ -634,10 +866,18 @@ class PushGraspStrategy:
             # or slid off its face centre: the wrist would roll the layer about an axis off the cube's, and the
             # layer orbits and drags the held one (measured: D2 after a 15 mm slide dragged it 27 deg, SAPIEN)
             q7 = float(rot.arm.positions()[-1]) + self._roll_delta(t)
-            if (rot.depth != 1 or not rot.arm.lower[-1] <= q7 <= rot.arm.upper[-1]
-                    or abs(rot.slide) > self.config.max_twist_slide):
-                rec.event("rotator_regrip", hand=rot.side, depth=rot.depth, q7_after_twist=q7,
-                          slide_mm=1000 * rot.slide)
+            if (
+                rot.depth != 1
+                or not rot.arm.lower[-1] <= q7 <= rot.arm.upper[-1]
+                or abs(rot.slide) > self.config.max_twist_slide
+            ):
+                rec.event(
+                    "rotator_regrip",
+                    hand=rot.side,
+                    depth=rot.depth,
+                    q7_after_twist=q7,
+                    slide_mm=1000 * rot.slide,
+                )
                 self._release_hand(rot)
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             if hold.holding and hold.depth == 2 and not rot.holding:
@@ -660,16 +900,32 @@ class PushGraspStrategy:
         want = q[-1] + delta
         q[-1] = np.clip(want, rot.arm.lower[-1], rot.arm.upper[-1])
         if abs(q[-1] - want) > 1e-6:
-            rec.event("warning", message=f"twist {k + 1}: wrist roll limited to {math.degrees(q[-1]):.0f}° "
-                      f"({math.degrees(want - q[-1]):.0f}° short)")
-        rot.arm.move_to_joints(q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2)
+            rec.event(
+                "warning",
+                message=f"twist {k + 1}: wrist roll limited to {math.degrees(q[-1]):.0f}° "
+                f"({math.degrees(want - q[-1]):.0f}° short)",
+            )
+        rot.arm.move_to_joints(
+            q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2
+        )
         rot.cmd = rot.last_grip = rolled_about_approach(rot.cmd, delta)
         self._open_outer(rot)
         out = cube.end_twist()
-        rec.move(t.source, str(move), outcome=out.summary(), moves=out.moves, layer_angles_deg=list(out.layer_angles_deg),
-                 jammed=out.jammed, misaligned=out.misaligned, as_intended=out.as_intended, body_axis=body_axis)
+        rec.move(
+            t.source,
+            str(move),
+            outcome=out.summary(),
+            moves=out.moves,
+            layer_angles_deg=list(out.layer_angles_deg),
+            jammed=out.jammed,
+            misaligned=out.misaligned,
+            as_intended=out.as_intended,
+            body_axis=body_axis,
+        )
         if out.unintended_rotation:
-            rec.unintended_rotation(t.source, str(move), out.moves or "misaligned", dragged_deg=out.dragged_deg)
+            rec.unintended_rotation(
+                t.source, str(move), out.moves or "misaligned", dragged_deg=out.dragged_deg
+            )
         if out.jammed:
             rec.blocked_rotation(t.source, str(move), "the turning layer did not turn (jammed)")
             raise StrategyFailure("jammed", f"twist {k + 1} ({move}) jammed: {out.summary()}")
@@ -677,10 +933,14 @@ class PushGraspStrategy:
         self._release_hand(rot)
 
     def _regrasp(self, a: Regrasp, k: int) -> None:
-        if a.kind == "unwind":  # the rotator lets go, rolls back (a fresh push-grasp choice) and re-grips
+        if (
+            a.kind == "unwind"
+        ):  # the rotator lets go, rolls back (a fresh push-grasp choice) and re-grips
             rot = self.hands[a.gripper]
             self._release_hand(rot)
-            self._push_grasp(rot, SIDE_DIR[rot.side], 1, "unwind", self._next_twist_delta(k, rot.side))
+            self._push_grasp(
+                rot, SIDE_DIR[rot.side], 1, "unwind", self._next_twist_delta(k, rot.side)
+            )
             return
         if a.kind != "shift":
             raise StrategyFailure(None, f"regrasp {a.kind!r} is not implemented")
@@ -689,7 +949,9 @@ class PushGraspStrategy:
         self._release_hand(new_hold)
         self._push_grasp(new_hold, SIDE_DIR[new_hold.side], 2, "shift in", k=k, perpendicular=True)
         self._release_hand(new_rot)
-        self._push_grasp(new_rot, SIDE_DIR[new_rot.side], 1, "shift out", self._next_twist_delta(k, new_rot.side))
+        self._push_grasp(
+            new_rot, SIDE_DIR[new_rot.side], 1, "shift out", self._next_twist_delta(k, new_rot.side)
+        )
 
     def _handover(self, a: Handover, k: int) -> None:
         giver, taker = self.hands[a.giver], self.hands[a.taker]
@@ -700,8 +962,12 @@ class PushGraspStrategy:
         angle = a.quarter_turns * math.pi / 2
         start = giver.cmd
         for i in range(1, n + 1):
-            self._send(giver, rotate_about_point(start, centre, a.axis, angle * i / n), label="hand-over turn",
-                       settle=0.05 if i < n else 0.2)
+            self._send(
+                giver,
+                rotate_about_point(start, centre, a.axis, angle * i / n),
+                label="hand-over turn",
+                settle=0.05 if i < n else 0.2,
+            )
         tdepth = 1 if a.rotator == taker.side else 2
         # the giver's thumb, curled over its face, is where the taker's outer finger closes (measured: the
         # taker's finger 2 stopped on it): once the taker's thumb is on its face, the giver straightens it
@@ -711,12 +977,27 @@ class PushGraspStrategy:
         # where the giver's fingers reach the taker's, the take slides across its face to clear them
         # (_clear_lateral), and a slid rotator grips again before its twist (_twist)
         delta = self._next_twist_delta(k, taker.side) if tdepth == 1 else 0.0
-        self._push_grasp(taker, SIDE_DIR[taker.side], tdepth, "hand-over take", delta, k=k,
-                         perpendicular=not cfg.taker_parallel, parallel=cfg.taker_parallel, before_close=straighten)
+        self._push_grasp(
+            taker,
+            SIDE_DIR[taker.side],
+            tdepth,
+            "hand-over take",
+            delta,
+            k=k,
+            perpendicular=not cfg.taker_parallel,
+            parallel=cfg.taker_parallel,
+            before_close=straighten,
+        )
         self._release_hand(giver, retreat=0.12)
         gdepth = 3 - tdepth
-        self._push_grasp(giver, SIDE_DIR[giver.side], gdepth, "hand-over re-grip",
-                         self._next_twist_delta(k, giver.side) if gdepth == 1 else 0.0, k=k)
+        self._push_grasp(
+            giver,
+            SIDE_DIR[giver.side],
+            gdepth,
+            "hand-over re-grip",
+            self._next_twist_delta(k, giver.side) if gdepth == 1 else 0.0,
+            k=k,
+        )
 
     def _release(self) -> None:
         for hand in self.hands.values():

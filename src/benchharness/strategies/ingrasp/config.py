@@ -49,10 +49,14 @@ class IngraspConfig:
     w_contact_pos: float = 1.0e5
     w_contact_rot: float = 1.0e3
     w_smooth: float = 1.0e-1  #: sum of squared joint steps (rad^2)
-    w_limits: float = 1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
+    w_limits: float = (
+        1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
+    )
     max_iterations: int = 150  #: L-BFGS iterations in all (the planning-time budget)
     inner_iterations: int = 25  #: per L-BFGS call; convergence is checked between calls
-    ftol: float = 1.0e-6  #: relative cost decrease over one call below which the optimiser is converged
+    ftol: float = (
+        1.0e-6  #: relative cost decrease over one call below which the optimiser is converged
+    )
     gtol: float = 1.0e-7  #: gradient max-norm below which the optimiser is converged
     init_noise: float = 1.0e-4  #: rad, seeded perturbation of the constant initial trajectory
     seed: int = 0  #: seed of that perturbation (torch.Generator); same seed, same trajectory
@@ -62,7 +66,9 @@ class IngraspConfig:
         if self.waypoints < 1:
             raise ValueError("waypoints must be >= 1")
         if self.object_frame not in ("reference-finger", "fingertips"):
-            raise ValueError(f"object_frame must be 'reference-finger' or 'fingertips', not {self.object_frame!r}")
+            raise ValueError(
+                f"object_frame must be 'reference-finger' or 'fingertips', not {self.object_frame!r}"
+            )
         if self.duration_s <= 0 or self.max_joint_speed <= 0:
             raise ValueError("duration_s and max_joint_speed must be positive")
 

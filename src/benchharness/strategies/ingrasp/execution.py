@@ -89,19 +89,27 @@ class ExecConfig:
     setup_pos_std: float = 0.001  #: m, per axis, set-up noise of the object position (palm frame)
     setup_rot_std_deg: float = 0.5  #: deg, per axis, set-up noise of the object orientation
     squeeze_force: float = 3.0  #: N, mean internal fingertip force (the grip) added to the plan
-    preshape_open: float = 0.008  #: m, fingertips backed off from the surface before the grasp closes
+    preshape_open: float = (
+        0.008  #: m, fingertips backed off from the surface before the grasp closes
+    )
     close_s: float = 0.4  #: s, closing onto the object held by the "human" constraint
     settle_s: float = 0.4  #: s, after the constraint is removed, before the set-up pose is taken
     hold_s: float = 5.0  #: s, stability check after execution (paper II-E)
-    object_friction: float | None = None  #: object's friction coefficient; None = the physics default
+    object_friction: float | None = (
+        None  #: object's friction coefficient; None = the physics default
+    )
     control_period: float = 1.0 / 120.0  #: s between joint target updates
     check_period: float = 0.02  #: s between drop checks
-    drop_no_contact_s: float = 0.1  #: s without any used fingertip touching the object that count as a drop
+    drop_no_contact_s: float = (
+        0.1  #: s without any used fingertip touching the object that count as a drop
+    )
     #: m, how much farther than at the grasp the object's centre may get from the fingertip centroid before
     #: it counts as dropped
     drop_distance: float = 0.03
     max_speed: float = 5.0  #: m/s, object speed treated as a physics blow-up
-    reanchor_setup: bool = True  #: reached = executed displacement applied to H_i (paper's set-up correction)
+    reanchor_setup: bool = (
+        True  #: reached = executed displacement applied to H_i (paper's set-up correction)
+    )
     max_placement_gap: float = 0.002  #: m, placement fit worse than this is refused (unreachable)
 
     def __post_init__(self) -> None:
@@ -110,8 +118,16 @@ class ExecConfig:
         for name in ("hand_height", "control_period", "check_period", "drop_distance", "max_speed"):
             if getattr(self, name) <= 0:
                 raise ValueError(f"{name} must be positive")
-        for name in ("setup_pos_std", "setup_rot_std_deg", "squeeze_force", "preshape_open", "close_s",
-                     "settle_s", "hold_s", "drop_no_contact_s"):
+        for name in (
+            "setup_pos_std",
+            "setup_rot_std_deg",
+            "squeeze_force",
+            "preshape_open",
+            "close_s",
+            "settle_s",
+            "hold_s",
+            "drop_no_contact_s",
+        ):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0")
         if self.object_friction is not None and self.object_friction < 0:
@@ -137,20 +153,27 @@ class _Dropped(Exception):
         self.reason = reason
 
 
-def _jacobians(hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+def _jacobians(
+    hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...]
+) -> tuple[np.ndarray, np.ndarray]:
     """Fingertip positions (k, 3) and position Jacobians (k, 3, 4) w.r.t. each finger's own joints."""
     qt = torch.as_tensor(np.asarray(q, float), dtype=DTYPE)
     fn = lambda z: hand.tip_poses(z[None], fingers)[0, :, :3, 3]  # noqa: E731
     jac = torch.autograd.functional.jacobian(fn, qt)  # (k, 3, 4k)
     k = len(fingers)
-    blocks = np.stack([jac[i, :, 4 * i: 4 * i + 4].numpy() for i in range(k)])
+    blocks = np.stack([jac[i, :, 4 * i : 4 * i + 4].numpy() for i in range(k)])
     with torch.no_grad():
         pos = fn(qt).numpy()
     return pos, blocks
 
 
-def squeeze_offsets(hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...], force: float,
-                    stiffness: np.ndarray) -> np.ndarray:
+def squeeze_offsets(
+    hand: HandKinematics,
+    q: np.ndarray,
+    fingers: tuple[str, ...],
+    force: float,
+    stiffness: np.ndarray,
+) -> np.ndarray:
     """Joint offsets (4 k,) that press the fingertips with internal forces ``s (g - p_i)``, mean ``force`` N."""
     pos, jac = _jacobians(hand, q, fingers)
     d = pos.mean(axis=0) - pos
@@ -159,7 +182,9 @@ def squeeze_offsets(hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...
     return tau / np.asarray(stiffness, float)
 
 
-def backoff_offsets(hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...], distance: float) -> np.ndarray:
+def backoff_offsets(
+    hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...], distance: float
+) -> np.ndarray:
     """Joint offsets (4 k,) moving each fingertip ``distance`` away from the fingertip centroid (least norm)."""
     pos, jac = _jacobians(hand, q, fingers)
     d = pos - pos.mean(axis=0)
@@ -172,7 +197,9 @@ def _mat(pose) -> np.ndarray:
 
 
 def _random_rotation(rng: np.random.Generator, std_rad: float) -> np.ndarray:
-    return Rotation.from_rotvec(rng.normal(0.0, std_rad, 3)).as_matrix() if std_rad > 0 else np.eye(3)
+    return (
+        Rotation.from_rotvec(rng.normal(0.0, std_rad, 3)).as_matrix() if std_rad > 0 else np.eye(3)
+    )
 
 
 class InGraspExecutor:
@@ -185,12 +212,26 @@ class InGraspExecutor:
     # ----------------------------------------------------------------- set-up geometry
     def placement(self, problem: InGraspProblem, object_name: str) -> Placement:
         """Where the (noise-free) object sits at ``q_0``; cached per task and object."""
-        return _cached_placement(self.hand, problem.task_id, object_name, tuple(np.round(problem.q_rest, 12)),
-                                 problem.fingers)
+        return _cached_placement(
+            self.hand,
+            problem.task_id,
+            object_name,
+            tuple(np.round(problem.q_rest, 12)),
+            problem.fingers,
+        )
 
     # ----------------------------------------------------------------- the trial
-    def run(self, backend, robot, problem: InGraspProblem, plan: PlanResult, object_name: str,
-            rng: np.random.Generator, recorder=None, duration_s: float = 1.67) -> ExecResult:
+    def run(
+        self,
+        backend,
+        robot,
+        problem: InGraspProblem,
+        plan: PlanResult,
+        object_name: str,
+        rng: np.random.Generator,
+        recorder=None,
+        duration_s: float = 1.67,
+    ) -> ExecResult:
         """Set up, execute ``plan`` (timed over ``duration_s``) and hold, in ``backend`` with ``robot``.
 
         Raises :class:`~benchharness.backends.interface.SimulationError` on a
@@ -203,19 +244,25 @@ class InGraspExecutor:
         cfg = self.config
         hand_joints = tuple(getattr(getattr(robot, "grippers", {}).get("hand"), "joints", ()))
         if hand_joints != tuple(f"joint_{i}" for i in range(16)):
-            raise ValueError("in-grasp execution needs the allegro robot (a 16-joint 'hand' joint_0..joint_15), "
-                             f"got {getattr(robot, 'name', robot)!r}")
+            raise ValueError(
+                "in-grasp execution needs the allegro robot (a 16-joint 'hand' joint_0..joint_15), "
+                f"got {getattr(robot, 'name', robot)!r}"
+            )
         wall0 = time.perf_counter()
         place = self.placement(problem, object_name)
         if place.max_gap > cfg.max_placement_gap:
-            raise ValueError(f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
-                             f"(best gap {place.max_gap * 1e3:.1f} mm)")
+            raise ValueError(
+                f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
+                f"(best gap {place.max_gap * 1e3:.1f} mm)"
+            )
         wall_place = time.perf_counter() - wall0
         model = load_object(object_name)
 
         hand_grip = robot.gripper("hand")
         kp = np.asarray(hand_grip.config.stiffness, float)
-        idx = np.concatenate([np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in problem.fingers])
+        idx = np.concatenate(
+            [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in problem.fingers]
+        )
         q0 = problem.q_rest.copy()
         sq0 = squeeze_offsets(self.hand, q0[idx], problem.fingers, cfg.squeeze_force, kp[idx])
         back = backoff_offsets(self.hand, q0[idx], problem.fingers, cfg.preshape_open)
@@ -245,33 +292,49 @@ class InGraspExecutor:
         obj = backend.add_body(pose=Pose.from_matrix(palm_w @ b_noisy), **kw)
         if recorder is not None:
             recorder.watch_contact(obj, robot.body)
-            recorder.event("setup_placement", task=problem.task_id, object=object_name,
-                           tip_gaps_mm=(place.tip_gaps * 1e3).round(3).tolist(),
-                           penetration_mm=round(place.penetration * 1e3, 3),
-                           noise_pos_mm=(dp * 1e3).round(3).tolist(),
-                           noise_rot_deg=float(np.degrees(Rotation.from_matrix(dr).magnitude())))
+            recorder.event(
+                "setup_placement",
+                task=problem.task_id,
+                object=object_name,
+                tip_gaps_mm=(place.tip_gaps * 1e3).round(3).tolist(),
+                penetration_mm=round(place.penetration * 1e3, 3),
+                noise_pos_mm=(dp * 1e3).round(3).tolist(),
+                noise_rot_deg=float(np.degrees(Rotation.from_matrix(dr).magnitude())),
+            )
         a_task = np.linalg.inv(b_nom) @ problem.object_initial  # task frame in the body frame
         extra: dict[str, Any] = {
-            "palm": cfg.palm, "squeeze_force_n": cfg.squeeze_force, "placement_gap_mm": round(place.max_gap * 1e3, 4),
+            "palm": cfg.palm,
+            "squeeze_force_n": cfg.squeeze_force,
+            "placement_gap_mm": round(place.max_gap * 1e3, 4),
             "placement_penetration_mm": round(place.penetration * 1e3, 3),
             "placement_rotation_change_deg": round(place.rotation_change_deg, 3),
             "setup_noise_pos_mm": (dp * 1e3).round(4).tolist(),
-            "setup_noise_rot_deg": round(float(np.degrees(Rotation.from_matrix(dr).magnitude())), 4),
+            "setup_noise_rot_deg": round(
+                float(np.degrees(Rotation.from_matrix(dr).magnitude())), 4
+            ),
             "wall_placement_s": round(wall_place, 3),
         }
         t_start = float(backend.time)
         per = max(1, int(round(cfg.control_period / backend.config.timestep)))
         tip_links = {TIP_LINKS[f] for f in problem.fingers}
         tips0 = self.hand.tip_poses_np(q0[idx][None], problem.fingers)[0][:, :3, 3]
-        state = {"last_contact": float(backend.time), "checked": float(backend.time),
-                 "com_dist": float(np.linalg.norm(c_nom - tips0.mean(axis=0)))}
+        state = {
+            "last_contact": float(backend.time),
+            "checked": float(backend.time),
+            "com_dist": float(np.linalg.norm(c_nom - tips0.mean(axis=0))),
+        }
 
         def obj_in_palm() -> np.ndarray:
             return np.linalg.inv(palm_w) @ _mat(backend.get_pose(obj))
 
         def tips_centroid() -> np.ndarray:
-            return np.mean([_mat(backend.get_link_pose(robot.body, TIP_LINKS[f]))[:3, 3] for f in problem.fingers],
-                           axis=0)
+            return np.mean(
+                [
+                    _mat(backend.get_link_pose(robot.body, TIP_LINKS[f]))[:3, 3]
+                    for f in problem.fingers
+                ],
+                axis=0,
+            )
 
         def check(active: bool) -> None:
             """Drop and blow-up checks (``active``: only once the object is free)."""
@@ -280,7 +343,9 @@ class InGraspExecutor:
             if float(np.linalg.norm(lin)) > cfg.max_speed:
                 from benchharness.backends.interface import SimulationError
 
-                raise SimulationError(f"object speed {np.linalg.norm(lin):.1f} m/s (> {cfg.max_speed} m/s): blow-up")
+                raise SimulationError(
+                    f"object speed {np.linalg.norm(lin):.1f} m/s (> {cfg.max_speed} m/s): blow-up"
+                )
             if not active:
                 return
             now = float(backend.time)
@@ -294,8 +359,10 @@ class InGraspExecutor:
             com_w = _mat(backend.get_pose(obj)) @ np.append(com, 1.0)
             dist = float(np.linalg.norm(com_w[:3] - tips_centroid()))
             if dist > state["com_dist"] + cfg.drop_distance:
-                raise _Dropped(f"object centre {dist * 100:.1f} cm from the fingertip centroid "
-                               f"({state['com_dist'] * 100:.1f} cm at the grasp)")
+                raise _Dropped(
+                    f"object centre {dist * 100:.1f} cm from the fingertip centroid "
+                    f"({state['com_dist'] * 100:.1f} cm at the grasp)"
+                )
 
         def run_for(seconds: float, target_fn, active: bool) -> None:
             n = max(1, int(round(seconds / (per * backend.config.timestep))))
@@ -316,26 +383,45 @@ class InGraspExecutor:
         try:
             # 1. set-up: the "human" holds the object against the palm frame while the fingers close
             human = backend.attach(robot.body, "palm_link", obj, None, Pose.from_matrix(b_noisy))
-            run_for(cfg.close_s, lambda t: q_pre + (q_closed - q_pre) * min(1.0, t / max(cfg.close_s * 0.5, 1e-9)),
-                    active=False)
+            run_for(
+                cfg.close_s,
+                lambda t: q_pre + (q_closed - q_pre) * min(1.0, t / max(cfg.close_s * 0.5, 1e-9)),
+                active=False,
+            )
             backend.detach(human)
             state["last_contact"] = float(backend.time)
             run_for(cfg.settle_s, lambda t: q_closed, active=True)
             b_setup = obj_in_palm()
             setup_m = b_setup @ a_task
-            tips_setup = [lk for lk in tip_links if any(c.link_b == lk for c in backend.contacts(obj, robot.body))]
+            tips_setup = [
+                lk
+                for lk in tip_links
+                if any(c.link_b == lk for c in backend.contacts(obj, robot.body))
+            ]
             extra["setup_tip_contacts"] = sorted(tips_setup)
-            extra["setup_joint_error_rad"] = round(float(np.max(np.abs(robot.joint_positions()[idx] - q0[idx]))), 5)
+            extra["setup_joint_error_rad"] = round(
+                float(np.max(np.abs(robot.joint_positions()[idx] - q0[idx]))), 5
+            )
             if recorder is not None:
-                recorder.event("setup", pose=pose_vector(setup_m).round(6).tolist(), tip_contacts=sorted(tips_setup))
+                recorder.event(
+                    "setup",
+                    pose=pose_vector(setup_m).round(6).tolist(),
+                    tip_contacts=sorted(tips_setup),
+                )
 
             # 2. execution: planned joints (linear between waypoints) + squeeze offset, as position targets
             phase = "execution"
             traj = np.asarray(plan.q_hand, float)
             n_wp = traj.shape[0] - 1
             dur = float(duration_s)
-            offs = np.array([squeeze_offsets(self.hand, traj[w, idx], problem.fingers, cfg.squeeze_force, kp[idx])
-                             for w in range(n_wp + 1)])
+            offs = np.array(
+                [
+                    squeeze_offsets(
+                        self.hand, traj[w, idx], problem.fingers, cfg.squeeze_force, kp[idx]
+                    )
+                    for w in range(n_wp + 1)
+                ]
+            )
             targets = traj.copy()
             targets[:, idx] += offs
 
@@ -357,7 +443,9 @@ class InGraspExecutor:
             dropped, message = False, ""
             drift = np.linalg.inv(b_exec) @ b_final
             extra["hold_drift_mm"] = round(float(np.linalg.norm(drift[:3, 3])) * 1e3, 4)
-            extra["hold_drift_deg"] = round(float(np.degrees(Rotation.from_matrix(drift[:3, :3]).magnitude())), 4)
+            extra["hold_drift_deg"] = round(
+                float(np.degrees(Rotation.from_matrix(drift[:3, :3]).magnitude())), 4
+            )
         except _Dropped as d:
             dropped, message = True, f"dropped during {phase}: {d.reason}"
             b_final = obj_in_palm()
@@ -366,30 +454,40 @@ class InGraspExecutor:
                 setup_m = b_final @ a_task
             if phase == "execution":
                 exec_sim = float(backend.time) - t_exec
-        tips_final = sorted(lk for lk in tip_links if any(c.link_b == lk for c in backend.contacts(obj, robot.body)))
+        tips_final = sorted(
+            lk for lk in tip_links if any(c.link_b == lk for c in backend.contacts(obj, robot.body))
+        )
         if cfg.reanchor_setup:
             reached_m = b_final @ np.linalg.inv(b_setup) @ problem.object_initial
         else:
             reached_m = b_final @ a_task
         extra.update(
-            phase=phase, final_tip_contacts=tips_final, sim_total_s=round(float(backend.time) - t_start, 4),
+            phase=phase,
+            final_tip_contacts=tips_final,
+            sim_total_s=round(float(backend.time) - t_start, 4),
             wall_exec_s=round(time.perf_counter() - wall0 - wall_place, 3),
             reached_unanchored=pose_vector(b_final @ a_task).round(7).tolist(),
             exec_config=asdict(cfg),
         )
         if recorder is not None:
             recorder.event("end", phase=phase, dropped=dropped, message=message)
-        return ExecResult(pose_vector(setup_m), pose_vector(reached_m), dropped, phase, message, exec_sim, extra)
+        return ExecResult(
+            pose_vector(setup_m), pose_vector(reached_m), dropped, phase, message, exec_sim, extra
+        )
 
 
 _PLACEMENTS: dict[tuple, Placement] = {}
 
 
-def _cached_placement(hand: HandKinematics, task_id: str, object_name: str, q_rest: tuple, fingers: tuple) -> Placement:
+def _cached_placement(
+    hand: HandKinematics, task_id: str, object_name: str, q_rest: tuple, fingers: tuple
+) -> Placement:
     from benchharness.objects import load_object
 
     key = (task_id, object_name, q_rest, fingers)
     if key not in _PLACEMENTS:
         v, n, c, sym = object_surface_arrays(load_object(object_name))
-        _PLACEMENTS[key] = place_object(hand, np.asarray(q_rest, float), fingers, v, n, c, symmetric=sym)
+        _PLACEMENTS[key] = place_object(
+            hand, np.asarray(q_rest, float), fingers, v, n, c, symmetric=sym
+        )
     return _PLACEMENTS[key]

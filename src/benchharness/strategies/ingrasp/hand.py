@@ -12,8 +12,8 @@ path so tests can check the two agree.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 import torch
@@ -23,7 +23,12 @@ __all__ = ["FINGERS", "TIP_LINKS", "HandKinematics"]
 DTYPE = torch.float64
 #: Benchmark finger numbering (dataset column ``fingers``) -> name.
 FINGERS = ("index", "middle", "ring", "thumb")
-TIP_LINKS = {"index": "link_3_tip", "middle": "link_7_tip", "ring": "link_11_tip", "thumb": "link_15_tip"}
+TIP_LINKS = {
+    "index": "link_3_tip",
+    "middle": "link_7_tip",
+    "ring": "link_11_tip",
+    "thumb": "link_15_tip",
+}
 
 
 def _default_urdf() -> Path:
@@ -44,10 +49,16 @@ class HandKinematics:
             warnings.simplefilter("ignore")
             import pytorch_kinematics as pk
 
-            text = Path(urdf or _default_urdf()).read_text() if not str(urdf or "").lstrip().startswith("<") else str(urdf)
+            text = (
+                Path(urdf or _default_urdf()).read_text()
+                if not str(urdf or "").lstrip().startswith("<")
+                else str(urdf)
+            )
             self.fingers = tuple(fingers)
             self.chains = {
-                f: pk.build_serial_chain_from_urdf(text.encode(), TIP_LINKS[f], "palm_link").to(dtype=DTYPE)
+                f: pk.build_serial_chain_from_urdf(text.encode(), TIP_LINKS[f], "palm_link").to(
+                    dtype=DTYPE
+                )
                 for f in FINGERS
             }
         lo, hi = [], []
@@ -68,7 +79,11 @@ class HandKinematics:
             offs, axes, pending = [], [], torch.eye(4, dtype=DTYPE)
             for name in self.chains[f].get_frame_names(exclude_fixed=False):
                 joint = self.chains[f].find_frame(name).joint
-                off = torch.eye(4, dtype=DTYPE) if joint.offset is None else joint.offset.get_matrix()[0].to(DTYPE)
+                off = (
+                    torch.eye(4, dtype=DTYPE)
+                    if joint.offset is None
+                    else joint.offset.get_matrix()[0].to(DTYPE)
+                )
                 pending = pending @ off
                 if joint.joint_type == "revolute":
                     offs.append(pending)
@@ -78,11 +93,18 @@ class HandKinematics:
                     raise ValueError(f"{f}: unsupported joint type {joint.joint_type}")
             if len(offs) != 4:
                 raise ValueError(f"{f}: expected 4 revolute joints, found {len(offs)}")
-            self._offsets[f], self._axes[f], self._tail[f] = torch.stack(offs), torch.stack(axes), pending
+            self._offsets[f], self._axes[f], self._tail[f] = (
+                torch.stack(offs),
+                torch.stack(axes),
+                pending,
+            )
 
     def limits(self, fingers: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper joint limits of ``fingers``' joints, concatenated (rad)."""
-        return (np.concatenate([self._lower[f] for f in fingers]), np.concatenate([self._upper[f] for f in fingers]))
+        return (
+            np.concatenate([self._lower[f] for f in fingers]),
+            np.concatenate([self._upper[f] for f in fingers]),
+        )
 
     def tip_poses(self, q: torch.Tensor, fingers: Sequence[str]) -> torch.Tensor:
         """Fingertip transforms in the palm frame: ``q`` (B, 4 k) -> (B, k, 4, 4), differentiable."""
@@ -113,9 +135,14 @@ class HandKinematics:
     def tip_poses_pk(self, q: torch.Tensor, fingers: Sequence[str]) -> torch.Tensor:
         """As :meth:`tip_poses`, through pytorch-kinematics' generic chain walk (reference for tests)."""
         q = q.reshape(-1, 4 * len(fingers))
-        out = [self.chains[f].forward_kinematics(q[:, 4 * i: 4 * i + 4]).get_matrix() for i, f in enumerate(fingers)]
+        out = [
+            self.chains[f].forward_kinematics(q[:, 4 * i : 4 * i + 4]).get_matrix()
+            for i, f in enumerate(fingers)
+        ]
         return torch.stack(out, dim=1)
 
     def tip_poses_np(self, q: np.ndarray, fingers: Sequence[str]) -> np.ndarray:
         with torch.no_grad():
-            return self.tip_poses(torch.as_tensor(np.asarray(q, float), dtype=DTYPE), fingers).numpy()
+            return self.tip_poses(
+                torch.as_tensor(np.asarray(q, float), dtype=DTYPE), fingers
+            ).numpy()

@@ -48,7 +48,9 @@ class Placement:
     """The object's pose in the palm frame at the initial grasp and how well it fits."""
 
     pose: np.ndarray  #: 4x4, object (mesh / body) frame in the palm frame
-    tip_gaps: np.ndarray  #: (k,) m, surface distance minus sphere radius per used fingertip (0 = touching)
+    tip_gaps: (
+        np.ndarray
+    )  #: (k,) m, surface distance minus sphere radius per used fingertip (0 = touching)
     penetration: float  #: m, deepest object vertex inside any other hand part (0 = clear)
     cost: float  #: final least-squares cost
     rotation_change_deg: float  #: how far the pose turned away from its axis-aligned candidate
@@ -62,7 +64,9 @@ class Placement:
 class HandGeometry:
     """The hand's collision shapes per link (from the URDF): boxes (centre pose, half extents) and spheres."""
 
-    boxes: dict[str, list[tuple[np.ndarray, np.ndarray]]]  #: link -> [(4x4 in link frame, half extents)]
+    boxes: dict[
+        str, list[tuple[np.ndarray, np.ndarray]]
+    ]  #: link -> [(4x4 in link frame, half extents)]
     spheres: dict[str, list[tuple[np.ndarray, float]]]  #: link -> [(centre in link frame, radius)]
 
 
@@ -96,9 +100,13 @@ def hand_geometry(urdf: str | None = None) -> HandGeometry:
                 size = np.array([float(v) for v in g.find("box").get("size").split()])
                 boxes.setdefault(name, []).append((o, size / 2.0))
             elif g.find("sphere") is not None:
-                spheres.setdefault(name, []).append((o[:3, 3], float(g.find("sphere").get("radius"))))
+                spheres.setdefault(name, []).append(
+                    (o[:3, 3], float(g.find("sphere").get("radius")))
+                )
             else:
-                raise ValueError(f"link {name}: only box and sphere collision shapes are supported here")
+                raise ValueError(
+                    f"link {name}: only box and sphere collision shapes are supported here"
+                )
     return HandGeometry(boxes, spheres)
 
 
@@ -107,7 +115,7 @@ def link_frames(hand: HandKinematics, q16: np.ndarray) -> dict[str, np.ndarray]:
     out = {"palm_link": np.eye(4)}
     with torch.no_grad():
         for i, f in enumerate(FINGERS):
-            q = torch.as_tensor(np.asarray(q16, float)[4 * i: 4 * i + 4][None], dtype=DTYPE)
+            q = torch.as_tensor(np.asarray(q16, float)[4 * i : 4 * i + 4][None], dtype=DTYPE)
             for name, tf in hand.chains[f].forward_kinematics(q, end_only=False).items():
                 out[name] = tf.get_matrix()[0].numpy()
     return out
@@ -128,10 +136,22 @@ def _rotations(symmetric: bool) -> list[np.ndarray]:
     return out
 
 
-def place_object(hand: HandKinematics, q16: np.ndarray, fingers: tuple[str, ...], vertices: np.ndarray,
-                 normals: np.ndarray, com: np.ndarray, *, symmetric: bool = False, clearance: float = 0.001,
-                 w_rot: float = 0.003, w_com: float = 0.02, urdf: str | None = None, max_vertices: int = 400,
-                 refine: int = 4) -> Placement:
+def place_object(
+    hand: HandKinematics,
+    q16: np.ndarray,
+    fingers: tuple[str, ...],
+    vertices: np.ndarray,
+    normals: np.ndarray,
+    com: np.ndarray,
+    *,
+    symmetric: bool = False,
+    clearance: float = 0.001,
+    w_rot: float = 0.003,
+    w_com: float = 0.02,
+    urdf: str | None = None,
+    max_vertices: int = 400,
+    refine: int = 4,
+) -> Placement:
     """Solve the object pose in the palm frame so ``fingers``' tips touch the surface at ``q16``.
 
     ``vertices``/``normals``: the object's surface mesh in its body frame
@@ -149,14 +169,18 @@ def place_object(hand: HandKinematics, q16: np.ndarray, fingers: tuple[str, ...]
     tips_used = {TIP_LINKS[f] for f in fingers}
     tip_c, tip_r = [], []
     for f in fingers:
-        (c, r), = geo.spheres[TIP_LINKS[f]]
+        ((c, r),) = geo.spheres[TIP_LINKS[f]]
         tip_c.append((frames[TIP_LINKS[f]] @ np.append(c, 1.0))[:3])
         tip_r.append(r)
     tip_c, tip_r = np.array(tip_c), np.array(tip_r)
     # obstacles: every other shape, as (world<-box 4x4, half extents) and (centre, radius)
     obst_boxes = [(frames[l] @ o, h) for l, lst in geo.boxes.items() for o, h in lst if l in frames]
-    obst_sph = [((frames[l] @ np.append(c, 1.0))[:3], r) for l, lst in geo.spheres.items() for c, r in lst
-                if l in frames and l not in tips_used]
+    obst_sph = [
+        ((frames[l] @ np.append(c, 1.0))[:3], r)
+        for l, lst in geo.spheres.items()
+        for c, r in lst
+        if l in frames and l not in tips_used
+    ]
     inv_boxes = [(np.linalg.inv(m), h) for m, h in obst_boxes]
     tree = cKDTree(vertices)
     centroid = tip_c.mean(axis=0)
@@ -202,23 +226,43 @@ def place_object(hand: HandKinematics, q16: np.ndarray, fingers: tuple[str, ...]
     for i, r0 in enumerate(_rotations(symmetric)):
         for j, off in enumerate((0.0, 0.03, -0.03)):
             x0 = np.concatenate([centroid + off * nrm - r0 @ com, np.zeros(3)])
-            sol = least_squares(residuals, x0, args=(r0, False), method="trf", diff_step=1e-4, max_nfev=100,
-                                x_scale=scale)
+            sol = least_squares(
+                residuals,
+                x0,
+                args=(r0, False),
+                method="trf",
+                diff_step=1e-4,
+                max_nfev=100,
+                x_scale=scale,
+            )
             score = 2.0 * sol.cost + float(np.sum((3.0 * penetration(pose_of(sol.x, r0))) ** 2))
             ranked.append((round(score, 10), i, j, sol.x, r0))
     ranked.sort(key=lambda e: e[:3])
     # stage 2: the best few, with the hand's other parts kept out of the object
     best: tuple[float, float, np.ndarray, np.ndarray] | None = None
     for _, _, _, x1, r0 in ranked[:refine]:
-        sol = least_squares(residuals, x1, args=(r0, True), method="trf", diff_step=1e-4, max_nfev=200, x_scale=scale)
+        sol = least_squares(
+            residuals,
+            x1,
+            args=(r0, True),
+            method="trf",
+            diff_step=1e-4,
+            max_nfev=200,
+            x_scale=scale,
+        )
         cost = float(2.0 * sol.cost)
         key = (round(cost, 10), float(np.linalg.norm(sol.x[3:])))
         if best is None or key < best[:2]:
             best = (key[0], key[1], sol.x, r0)
     assert best is not None
     m = pose_of(best[2], best[3])
-    return Placement(m, gaps(m), float(np.max(penetration(m, vertices) - clearance, initial=0.0).clip(min=0.0)),
-                     best[0], float(np.degrees(np.linalg.norm(best[2][3:]))))
+    return Placement(
+        m,
+        gaps(m),
+        float(np.max(penetration(m, vertices) - clearance, initial=0.0).clip(min=0.0)),
+        best[0],
+        float(np.degrees(np.linalg.norm(best[2][3:]))),
+    )
 
 
 def object_surface_arrays(model) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
@@ -226,5 +270,7 @@ def object_surface_arrays(model) -> tuple[np.ndarray, np.ndarray, np.ndarray, bo
     mesh = model.surface
     com = np.asarray(model.body_kwargs().get("com") or np.zeros(3), float)
     ext = np.asarray(mesh.extents, float)
-    symmetric = bool(np.ptp(ext) < 1e-6 and abs(mesh.volume - np.pi * ext[0] ** 3 / 6.0) < 0.02 * mesh.volume)
+    symmetric = bool(
+        np.ptp(ext) < 1e-6 and abs(mesh.volume - np.pi * ext[0] ** 3 / 6.0) < 0.02 * mesh.volume
+    )
     return np.asarray(mesh.vertices, float), np.asarray(mesh.vertex_normals, float), com, symmetric

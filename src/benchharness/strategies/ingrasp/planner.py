@@ -56,7 +56,9 @@ class PlanResult:
     q_hand: np.ndarray  #: (T + 1, 16) whole hand (unused fingers hold the initial grasp)
     object_final: np.ndarray  #: 4x4 planned object pose in the palm frame at the last waypoint
     goal: np.ndarray  #: 4x4 desired object pose in the palm frame
-    reached: np.ndarray  #: (7,) planned pose ``[x, y, z, qx, qy, qz, qw]`` in the dataset's convention
+    reached: (
+        np.ndarray
+    )  #: (7,) planned pose ``[x, y, z, qx, qy, qz, qw]`` in the dataset's convention
     plan_time_s: float  #: wall time of the optimisation (set-up of the hand model excluded)
     converged: bool  #: stopped on the tolerances, not on the iteration budget
     iterations: int
@@ -89,8 +91,12 @@ def carrier_frames(tips: torch.Tensor, object_frame: str) -> torch.Tensor:
     return torch.cat([top, tips[:, 0, 3:4, :]], dim=-2)
 
 
-def object_poses(hand: HandKinematics, problem: InGraspProblem, q: torch.Tensor,
-                 object_frame: str = "reference-finger") -> torch.Tensor:
+def object_poses(
+    hand: HandKinematics,
+    problem: InGraspProblem,
+    q: torch.Tensor,
+    object_frame: str = "reference-finger",
+) -> torch.Tensor:
     """Object frame implied by the fingertips for joint rows ``q`` (B, 4 k) -> (B, 4, 4)."""
     q0 = torch.as_tensor(problem.q0, dtype=DTYPE)[None]
     c0 = carrier_frames(hand.tip_poses(q0, problem.fingers), object_frame)[0]
@@ -98,7 +104,9 @@ def object_poses(hand: HandKinematics, problem: InGraspProblem, q: torch.Tensor,
     return carrier_frames(hand.tip_poses(q, problem.fingers), object_frame) @ attach
 
 
-def project_trajectory(q: np.ndarray, q0: np.ndarray, lower: np.ndarray, upper: np.ndarray, max_step: float) -> np.ndarray:
+def project_trajectory(
+    q: np.ndarray, q0: np.ndarray, lower: np.ndarray, upper: np.ndarray, max_step: float
+) -> np.ndarray:
     """Nearest-by-clamping trajectory within joint limits and the per-step bound (rows after ``q0``).
 
     Clamping waypoint by waypoint is always feasible because each clamped
@@ -129,7 +137,9 @@ def fit_object_pose(points_obj: np.ndarray, points_palm: np.ndarray) -> np.ndarr
 class _Cost:
     """The variant's cost as a function of the waypoint block (T, 4 k)."""
 
-    def __init__(self, hand: HandKinematics, problem: InGraspProblem, variant: str, cfg: IngraspConfig) -> None:
+    def __init__(
+        self, hand: HandKinematics, problem: InGraspProblem, variant: str, cfg: IngraspConfig
+    ) -> None:
         self.hand, self.p, self.variant, self.cfg = hand, problem, variant, cfg
         t = lambda a: torch.as_tensor(np.asarray(a, float), dtype=DTYPE)  # noqa: E731
         self.q0 = t(problem.q0)
@@ -138,7 +148,9 @@ class _Cost:
         self.goal = t(problem.goal)
         x0 = hand.tip_poses(self.q0[None], problem.fingers)[0]  # (k, 4, 4)
         self.x_o0 = t(problem.object_initial)
-        self.attach = inverse(carrier_frames(x0[None], cfg.object_frame)[0]) @ self.x_o0  # object in its carrier frame
+        self.attach = (
+            inverse(carrier_frames(x0[None], cfg.object_frame)[0]) @ self.x_o0
+        )  # object in its carrier frame
         rel = inverse(self.x_o0)[None] @ x0  # fingertips in the object frame (k, 4, 4)
         self.tip_in_obj = rel
         self.obj_in_tip = inverse(x0) @ self.x_o0[None]  # object in each fingertip frame
@@ -150,29 +162,46 @@ class _Cost:
     def residuals(self, q: torch.Tensor) -> torch.Tensor:
         """All weighted residuals as one vector; the cost is its squared norm (a least-squares problem)."""
         cfg, v = self.cfg, self.variant
-        sq = lambda w, r: (w ** 0.5) * r.reshape(-1)  # noqa: E731
+        sq = lambda w, r: (w**0.5) * r.reshape(-1)  # noqa: E731
         x = self.hand.tip_poses(q, self.p.fingers)  # (T, k, 4, 4)
         parts = []
         if v in RELAXED:
             x_o = carrier_frames(x, cfg.object_frame) @ self.attach  # (T, 4, 4)
-            first = 1 if cfg.object_frame == "reference-finger" else 0  # the carrier finger cannot slip
+            first = (
+                1 if cfg.object_frame == "reference-finger" else 0
+            )  # the carrier finger cannot slip
             others = x[:, first:]
             if v == "relaxed-rigidity":
-                pred = others @ self.obj_in_tip[None, first:]  # object as each fingertip would carry it
+                pred = (
+                    others @ self.obj_in_tip[None, first:]
+                )  # object as each fingertip would carry it
                 parts.append(sq(cfg.w_rigid_pos, pred[..., :3, 3] - x_o[:, None, :3, 3]))
-                parts.append(sq(cfg.w_rigid_rot, rot_residual(x_o[:, None, :3, :3], pred[..., :3, :3])))
+                parts.append(
+                    sq(cfg.w_rigid_rot, rot_residual(x_o[:, None, :3, :3], pred[..., :3, :3]))
+                )
             else:
                 in_obj = inverse(x_o)[:, None] @ others  # fingertips in the object frame now
-                parts.append(sq(cfg.w_rigid_pos, in_obj[..., :3, 3] - self.tip_in_obj[None, first:, :3, 3]))
+                parts.append(
+                    sq(cfg.w_rigid_pos, in_obj[..., :3, 3] - self.tip_in_obj[None, first:, :3, 3])
+                )
                 if v == "relaxed-position-orientation":
-                    parts.append(sq(cfg.w_rigid_rot, rot_residual(self.tip_in_obj[None, first:, :3, :3], in_obj[..., :3, :3])))
+                    parts.append(
+                        sq(
+                            cfg.w_rigid_rot,
+                            rot_residual(
+                                self.tip_in_obj[None, first:, :3, :3], in_obj[..., :3, :3]
+                            ),
+                        )
+                    )
             xf = x_o[-1]
             parts.append(sq(cfg.w_goal_pos, xf[:3, 3] - self.goal[:3, 3]))
             parts.append(sq(cfg.w_goal_rot, rot_residual(self.goal[:3, :3], xf[:3, :3])))
         else:
             parts.append(sq(cfg.w_contact_pos, x[..., :3, 3] - self.targets[..., :3, 3]))
             if v == "ik-rigid":
-                parts.append(sq(cfg.w_contact_rot, rot_residual(self.targets[..., :3, :3], x[..., :3, :3])))
+                parts.append(
+                    sq(cfg.w_contact_rot, rot_residual(self.targets[..., :3, :3], x[..., :3, :3]))
+                )
         steps = torch.diff(torch.cat([self.q0[None], q]), dim=0)
         parts.append(sq(cfg.w_smooth, steps))
         parts.append(sq(cfg.w_limits, torch.relu(q - self.hi) + torch.relu(self.lo - q)))
@@ -183,7 +212,9 @@ class _Cost:
         return (self.residuals(q) ** 2).sum()
 
 
-def _lbfgs(cost: _Cost, init: torch.Tensor, cfg: IngraspConfig) -> tuple[torch.Tensor, bool, int, float]:
+def _lbfgs(
+    cost: _Cost, init: torch.Tensor, cfg: IngraspConfig
+) -> tuple[torch.Tensor, bool, int, float]:
     """Minimise the cost from ``init`` with L-BFGS (strong-Wolfe line search).
 
     Runs in calls of ``inner_iterations`` and stops when a call lowered the
@@ -193,8 +224,15 @@ def _lbfgs(cost: _Cost, init: torch.Tensor, cfg: IngraspConfig) -> tuple[torch.T
     long before the slip/smoothness trade-off is).
     """
     z = init.clone().requires_grad_(True)
-    opt = torch.optim.LBFGS([z], lr=1.0, max_iter=cfg.inner_iterations, history_size=20,
-                            line_search_fn="strong_wolfe", tolerance_grad=cfg.gtol, tolerance_change=1e-14)
+    opt = torch.optim.LBFGS(
+        [z],
+        lr=1.0,
+        max_iter=cfg.inner_iterations,
+        history_size=20,
+        line_search_fn="strong_wolfe",
+        tolerance_grad=cfg.gtol,
+        tolerance_change=1e-14,
+    )
 
     def closure():
         opt.zero_grad()
@@ -220,8 +258,12 @@ def _lbfgs(cost: _Cost, init: torch.Tensor, cfg: IngraspConfig) -> tuple[torch.T
     return z.detach(), converged, iters, final
 
 
-def plan(hand: HandKinematics, problem: InGraspProblem, variant: str = "relaxed-rigidity",
-         config: IngraspConfig = IngraspConfig()) -> PlanResult:
+def plan(
+    hand: HandKinematics,
+    problem: InGraspProblem,
+    variant: str = "relaxed-rigidity",
+    config: IngraspConfig = IngraspConfig(),  # noqa: B008 - frozen dataclass, immutable
+) -> PlanResult:
     """Optimise a joint trajectory for ``problem`` with ``variant``; deterministic for a given ``config.seed``."""
     if variant not in VARIANTS:
         raise ValueError(f"unknown variant {variant!r}; one of {', '.join(VARIANTS)}")
@@ -234,23 +276,44 @@ def plan(hand: HandKinematics, problem: InGraspProblem, variant: str = "relaxed-
     z, converged, iters, final_cost = _lbfgs(cost_fn, init, cfg)
     q_opt = z.detach().numpy()
     lo, hi = hand.limits(problem.fingers)
-    q_proj = project_trajectory(q_opt, problem.q0, lo + cfg.limit_margin, hi - cfg.limit_margin, cfg.max_step)
+    q_proj = project_trajectory(
+        q_opt, problem.q0, lo + cfg.limit_margin, hi - cfg.limit_margin, cfg.max_step
+    )
     q_all = np.vstack([problem.q0[None], q_proj])
     obj = _planned_object(hand, problem, variant, q_all[-1], cfg.object_frame)
     elapsed = time.perf_counter() - start
     q_hand = np.tile(problem.q_rest, (q_all.shape[0], 1))
     for i, f in enumerate(problem.fingers):
         j = FINGERS.index(f)
-        q_hand[:, 4 * j: 4 * j + 4] = q_all[:, 4 * i: 4 * i + 4]
+        q_hand[:, 4 * j : 4 * j + 4] = q_all[:, 4 * i : 4 * i + 4]
     dp = float(np.linalg.norm(obj[:3, 3] - problem.goal[:3, 3]))
     rel = problem.goal[:3, :3].T @ obj[:3, :3]
     dr = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
-    return PlanResult(variant, problem.fingers, q_all, q_hand, obj, problem.goal.copy(), pose_vector(obj), elapsed,
-                      converged, iters, final_cost, dp, dr, float(np.abs(q_proj - q_opt).max()))
+    return PlanResult(
+        variant,
+        problem.fingers,
+        q_all,
+        q_hand,
+        obj,
+        problem.goal.copy(),
+        pose_vector(obj),
+        elapsed,
+        converged,
+        iters,
+        final_cost,
+        dp,
+        dr,
+        float(np.abs(q_proj - q_opt).max()),
+    )
 
 
-def _planned_object(hand: HandKinematics, problem: InGraspProblem, variant: str, q_last: np.ndarray,
-                    object_frame: str) -> np.ndarray:
+def _planned_object(
+    hand: HandKinematics,
+    problem: InGraspProblem,
+    variant: str,
+    q_last: np.ndarray,
+    object_frame: str,
+) -> np.ndarray:
     """Object pose the plan implies: reference-finger attachment, or a contact fit for point-contact."""
     if variant == "point-contact":
         x0 = hand.tip_poses_np(problem.q0[None], problem.fingers)[0]
@@ -258,4 +321,6 @@ def _planned_object(hand: HandKinematics, problem: InGraspProblem, variant: str,
         x = hand.tip_poses_np(q_last[None], problem.fingers)[0]
         return fit_object_pose(c_obj, x[:, :3, 3])
     with torch.no_grad():
-        return object_poses(hand, problem, torch.as_tensor(q_last[None], dtype=DTYPE), object_frame)[0].numpy()
+        return object_poses(
+            hand, problem, torch.as_tensor(q_last[None], dtype=DTYPE), object_frame
+        )[0].numpy()

@@ -34,7 +34,9 @@ class InGraspProblem:
         return 4 * len(self.fingers)
 
 
-def clamp_grasp(q16: np.ndarray, hand: HandKinematics, margin: float = 0.0) -> tuple[np.ndarray, tuple[str, ...]]:
+def clamp_grasp(
+    q16: np.ndarray, hand: HandKinematics, margin: float = 0.0
+) -> tuple[np.ndarray, tuple[str, ...]]:
     """A published 16-joint grasp moved inside our joint limits, and the joints that moved."""
     lo, hi = hand.limits(FINGERS)
     q = np.clip(np.asarray(q16, float), lo + margin, hi - margin)
@@ -43,9 +45,15 @@ def clamp_grasp(q16: np.ndarray, hand: HandKinematics, margin: float = 0.0) -> t
     return q, moved
 
 
-def problem_from_task(task: InGraspTask, hand: HandKinematics, margin: float = 0.0) -> InGraspProblem:
+def problem_from_task(
+    task: InGraspTask, hand: HandKinematics, margin: float = 0.0
+) -> InGraspProblem:
     """Our problem for a published task (see :mod:`.tasks` for the frame conventions)."""
     q16, moved = clamp_grasp(task.q0_published, hand, margin)
-    idx = np.concatenate([np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in task.fingers])
+    idx = np.concatenate(
+        [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in task.fingers]
+    )
     h_i = pose_matrix(task.initial)
-    return InGraspProblem(task.fingers, q16[idx], h_i, task.goal_matrix(h_i), q16, task.task_id, moved)
+    return InGraspProblem(
+        task.fingers, q16[idx], h_i, task.goal_matrix(h_i), q16, task.task_id, moved
+    )

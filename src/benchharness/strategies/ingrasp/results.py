@@ -7,8 +7,8 @@ executed, so ``exec_time_s`` is left empty and no trial is dropped.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -19,7 +19,9 @@ from .tasks import InGraspTask
 __all__ = ["results_for_plans", "write_plan_results"]
 
 
-def results_for_plans(tasks: Sequence[InGraspTask], plans: Sequence[PlanResult], config: IngraspConfig | None = None):
+def results_for_plans(
+    tasks: Sequence[InGraspTask], plans: Sequence[PlanResult], config: IngraspConfig | None = None
+):
     """One results row per (task, plan); ``initial``/``desired`` are the published poses."""
     from benchharness.inhand.records import ResultSet
 
@@ -52,8 +54,12 @@ def results_for_plans(tasks: Sequence[InGraspTask], plans: Sequence[PlanResult],
     )
 
 
-def write_plan_results(path: str | Path, tasks: Sequence[InGraspTask], plans: Sequence[PlanResult],
-                       config: IngraspConfig | None = None) -> Path:
+def write_plan_results(
+    path: str | Path,
+    tasks: Sequence[InGraspTask],
+    plans: Sequence[PlanResult],
+    config: IngraspConfig | None = None,
+) -> Path:
     """Write the plans as a results CSV that ``benchharness inhand score`` reads."""
     from benchharness.inhand.fileformat import write_results
 

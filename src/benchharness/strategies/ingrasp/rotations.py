@@ -18,14 +18,19 @@ __all__ = ["rot_residual", "pose_matrix", "pose_vector", "interpolate_poses", "i
 def rot_residual(ra: torch.Tensor, rb: torch.Tensor) -> torch.Tensor:
     """``sin(angle) * axis`` of ``ra^T rb`` (..., 3): zero iff the rotations agree (for angles < 180 deg)."""
     m = ra.transpose(-1, -2) @ rb
-    return 0.5 * torch.stack((m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]), dim=-1)
+    return 0.5 * torch.stack(
+        (m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]),
+        dim=-1,
+    )
 
 
 def inverse(t: torch.Tensor) -> torch.Tensor:
     """Inverse of rigid transforms (..., 4, 4)."""
     r = t[..., :3, :3].transpose(-1, -2)
     top = torch.cat([r, -(r @ t[..., :3, 3:4])], dim=-1)
-    return torch.cat([top, t[..., 3:4, :]], dim=-2)  # functional (no in-place writes): forward-mode AD
+    return torch.cat(
+        [top, t[..., 3:4, :]], dim=-2
+    )  # functional (no in-place writes): forward-mode AD
 
 
 def pose_matrix(pose7) -> np.ndarray:

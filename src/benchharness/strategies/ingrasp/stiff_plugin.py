@@ -29,6 +29,11 @@ def make_stiff(**kwargs):
 
 @hookimpl
 def benchharness_strategies() -> list[Registration]:
-    return [Registration("relaxed-rigidity-stiff", make_stiff,
-                         "relaxed-rigidity with 100x rigidity weights (fingertip triangle kept; Allegro, Level I)",
-                         {"levels": [1], "hand": "allegro", "variant": "relaxed-rigidity"})]
+    return [
+        Registration(
+            "relaxed-rigidity-stiff",
+            make_stiff,
+            "relaxed-rigidity with 100x rigidity weights (fingertip triangle kept; Allegro, Level I)",
+            {"levels": [1], "hand": "allegro", "variant": "relaxed-rigidity"},
+        )
+    ]

@@ -46,10 +46,14 @@ def task_for_item(item) -> InGraspTask:
         raise ValueError(f"in-grasp planners run Level I tasks only, not level {item.level}")
     tasks = _published_by_id()
     if item.task_id not in tasks:
-        raise ValueError(f"task {item.task_id!r} has no published Allegro grasp "
-                         f"(tasks/inhand/published/allegro_lvl1_relaxed_rigidity.csv)")
+        raise ValueError(
+            f"task {item.task_id!r} has no published Allegro grasp "
+            f"(tasks/inhand/published/allegro_lvl1_relaxed_rigidity.csv)"
+        )
     t = tasks[item.task_id]
-    return replace(t, initial=np.asarray(item.initial, float), desired=np.asarray(item.desired, float))
+    return replace(
+        t, initial=np.asarray(item.initial, float), desired=np.asarray(item.desired, float)
+    )
 
 
 class InGraspPlanner:
@@ -61,9 +65,15 @@ class InGraspPlanner:
 
     benchmarks = ("inhand",)
 
-    def __init__(self, variant: str = "relaxed-rigidity", config: IngraspConfig | None = None,
-                 urdf: str | Path | None = None, hand: HandKinematics | None = None,
-                 exec_config: ExecConfig | None = None, **overrides) -> None:
+    def __init__(
+        self,
+        variant: str = "relaxed-rigidity",
+        config: IngraspConfig | None = None,
+        urdf: str | Path | None = None,
+        hand: HandKinematics | None = None,
+        exec_config: ExecConfig | None = None,
+        **overrides,
+    ) -> None:
         if variant not in VARIANTS:
             raise ValueError(f"unknown variant {variant!r}; one of {', '.join(VARIANTS)}")
         self.variant = variant
@@ -93,19 +103,46 @@ class InGraspPlanner:
         problem = self.problem(task)
         res = self.plan(problem)
         ctx.check_budget()
-        ctx.recorder.event("plan", variant=self.variant, plan_time_s=round(res.plan_time_s, 4),
-                           planned_reached=np.round(res.reached, 7).tolist(), converged=res.converged)
-        extra = {"variant": self.variant, "planned_reached": np.round(res.reached, 7).tolist(),
-                 "plan_pos_error_cm": round(res.pos_error * 100, 5), "plan_converged": res.converged}
+        ctx.recorder.event(
+            "plan",
+            variant=self.variant,
+            plan_time_s=round(res.plan_time_s, 4),
+            planned_reached=np.round(res.reached, 7).tolist(),
+            converged=res.converged,
+        )
+        extra = {
+            "variant": self.variant,
+            "planned_reached": np.round(res.reached, 7).tolist(),
+            "plan_pos_error_cm": round(res.pos_error * 100, 5),
+            "plan_converged": res.converged,
+        }
         executor = InGraspExecutor(self.hand, self.exec_config)
         try:
-            out = executor.run(ctx.backend, ctx.robot, problem, res, task.object, ctx.rng, ctx.recorder,
-                               duration_s=self.config.duration_s)
+            out = executor.run(
+                ctx.backend,
+                ctx.robot,
+                problem,
+                res,
+                task.object,
+                ctx.rng,
+                ctx.recorder,
+                duration_s=self.config.duration_s,
+            )
         except SimulationError as exc:  # a blow-up ends this trial with its cause, never the sweep
-            return TrialOutcome(failure="simulator_error", message=f"physics blow-up: {exc}",
-                                plan_time_s=res.plan_time_s, extra=extra)
+            return TrialOutcome(
+                failure="simulator_error",
+                message=f"physics blow-up: {exc}",
+                plan_time_s=res.plan_time_s,
+                extra=extra,
+            )
         extra.update(out.extra)
         return TrialOutcome(
-            reached=out.reached, setup=out.setup, dropped=out.dropped, plan_time_s=res.plan_time_s,
-            exec_time_s=out.exec_sim_s, message=out.message, failure="dropped" if out.dropped else None, extra=extra,
+            reached=out.reached,
+            setup=out.setup,
+            dropped=out.dropped,
+            plan_time_s=res.plan_time_s,
+            exec_time_s=out.exec_sim_s,
+            message=out.message,
+            failure="dropped" if out.dropped else None,
+            extra=extra,
         )

@@ -76,6 +76,14 @@ def published_tasks(path: str | Path | None = None, reference: str = "index") ->
     for i in range(len(rs)):
         q0 = np.array([float(rs.extra[c][i]) for c in cols])
         fingers = [int(x) for x in str(rs.extra["fingers"][i]).split(";") if x != ""]
-        out.append(InGraspTask(str(rs.task_id[i]), str(rs.object[i]), _order(fingers, reference), q0,
-                               np.asarray(rs.initial[i], float), np.asarray(rs.desired[i], float)))
+        out.append(
+            InGraspTask(
+                str(rs.task_id[i]),
+                str(rs.object[i]),
+                _order(fingers, reference),
+                q0,
+                np.asarray(rs.initial[i], float),
+                np.asarray(rs.desired[i], float),
+            )
+        )
     return out

@@ -12,7 +12,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-__all__ = ["GripConfig", "SetupConfig", "HoldConfig", "MotionConfig", "ExecutionConfig", "PivotConfig"]
+__all__ = [
+    "GripConfig",
+    "SetupConfig",
+    "HoldConfig",
+    "MotionConfig",
+    "ExecutionConfig",
+    "PivotConfig",
+]
 
 
 @dataclass(frozen=True)

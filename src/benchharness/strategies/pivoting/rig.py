@@ -31,8 +31,8 @@ tool centre point), **z** the closing direction from the principal (left,
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -41,7 +41,15 @@ from ...geometry import Pose
 from ...robots.descriptions.pr2 import FINGER_TRAVEL, FINGER_X, PAD_GAP, PAD_SIZE, TCP_X
 from .config import ExecutionConfig
 
-__all__ = ["HAND_IN_TCP", "TableRig", "RigFailure", "gripper_boxes", "clearance", "stable_rest_poses", "HoldResult"]
+__all__ = [
+    "HAND_IN_TCP",
+    "TableRig",
+    "RigFailure",
+    "gripper_boxes",
+    "clearance",
+    "stable_rest_poses",
+    "HoldResult",
+]
 
 #: The hand frame in the tool frame: x_h = x_tool, y_h = z_tool, z_h = -y_tool.
 HAND_IN_TCP = Rotation.from_matrix([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -70,10 +78,26 @@ def gripper_boxes(opening: float) -> list[tuple[np.ndarray, np.ndarray]]:
     bar_len = pad_cx - PAD_SIZE[0] / 2 - 0.02
     for sign in (1.0, -1.0):
         y0 = sign * q
-        out.append((np.array([palm_x + FINGER_X + pad_cx, y0 + sign * (PAD_GAP + PAD_SIZE[1] / 2), 0.0]),
-                    np.array(PAD_SIZE) / 2))
-        out.append((np.array([palm_x + FINGER_X + 0.02 + bar_len / 2, y0 + sign * (PAD_GAP + PAD_SIZE[1] + 0.004), 0.0]),
-                    np.array([bar_len / 2, 0.004, 0.01])))
+        out.append(
+            (
+                np.array(
+                    [palm_x + FINGER_X + pad_cx, y0 + sign * (PAD_GAP + PAD_SIZE[1] / 2), 0.0]
+                ),
+                np.array(PAD_SIZE) / 2,
+            )
+        )
+        out.append(
+            (
+                np.array(
+                    [
+                        palm_x + FINGER_X + 0.02 + bar_len / 2,
+                        y0 + sign * (PAD_GAP + PAD_SIZE[1] + 0.004),
+                        0.0,
+                    ]
+                ),
+                np.array([bar_len / 2, 0.004, 0.01]),
+            )
+        )
     return out
 
 
@@ -98,13 +122,19 @@ def _stable_poses(hull, com: np.ndarray):
 
     import trimesh
 
-    key = hashlib.sha1(np.ascontiguousarray(hull.vertices, float).tobytes() + np.asarray(com, float).tobytes()).hexdigest()
+    key = hashlib.sha1(
+        np.ascontiguousarray(hull.vertices, float).tobytes() + np.asarray(com, float).tobytes()
+    ).hexdigest()
     if key not in _STABLE_CACHE:
-        _STABLE_CACHE[key] = trimesh.poses.compute_stable_poses(hull, center_mass=com, threshold=0.0)
+        _STABLE_CACHE[key] = trimesh.poses.compute_stable_poses(
+            hull, center_mass=com, threshold=0.0
+        )
     return _STABLE_CACHE[key]
 
 
-def stable_rest_poses(mesh, com: Sequence[float], grasp_axis: Sequence[float], max_tilt_deg: float = 5.0) -> list[Pose]:
+def stable_rest_poses(
+    mesh, com: Sequence[float], grasp_axis: Sequence[float], max_tilt_deg: float = 5.0
+) -> list[Pose]:
     """Stable resting poses of the object on a table at z = 0 that keep ``grasp_axis`` (object frame) horizontal.
 
     From trimesh's quasi-static stable poses of the convex hull about the
@@ -137,7 +167,9 @@ class HoldResult:
     drift_position: float
     drift_angle_deg: float
     message: str
-    lift_slip_position: float = float("nan")  #: m, grasp change from the table to the end of the lift
+    lift_slip_position: float = float(
+        "nan"
+    )  #: m, grasp change from the table to the end of the lift
     lift_slip_angle_deg: float = float("nan")
 
 
@@ -159,8 +191,11 @@ class TableRig:
         b, g = self.backend, self.config.grip
         b.add_ground(self.config.motion.table_height, friction=g.table_friction)
         kw = self.model.body_kwargs()
-        self.body = b.add_body(pose=Pose(rest.p + [0, 0, self.config.motion.table_height], rest.q),
-                               friction=g.object_friction, **kw)
+        self.body = b.add_body(
+            pose=Pose(rest.p + [0, 0, self.config.motion.table_height], rest.q),
+            friction=g.object_friction,
+            **kw,
+        )
         self.rest = self.backend.get_pose(self.body)
         self.mass = float(kw["mass"])
         self.weight = self.mass * abs(float(b.config.gravity[2]))
@@ -174,8 +209,16 @@ class TableRig:
         m = self.config.motion
         if not noisy or (m.tracker_position_std <= 0 and m.tracker_angle_std <= 0):
             return pose
-        dp = self.rng.normal(0.0, m.tracker_position_std, 3) if m.tracker_position_std > 0 else np.zeros(3)
-        dr = self.rng.normal(0.0, math.radians(m.tracker_angle_std), 3) if m.tracker_angle_std > 0 else np.zeros(3)
+        dp = (
+            self.rng.normal(0.0, m.tracker_position_std, 3)
+            if m.tracker_position_std > 0
+            else np.zeros(3)
+        )
+        dr = (
+            self.rng.normal(0.0, math.radians(m.tracker_angle_std), 3)
+            if m.tracker_angle_std > 0
+            else np.zeros(3)
+        )
         return Pose.from_rotation(pose.p + dp, Rotation.from_rotvec(dr) * pose.rotation)
 
     def hand_world(self) -> Pose:
@@ -239,7 +282,13 @@ class TableRig:
     def tighten(self) -> None:
         self.set_grip(self.config.grip.hold_force, centred=True)
 
-    def follow(self, hand_in_object: Sequence[Pose], *, object_pose: Pose | None = None, settle: float = 0.2) -> float:
+    def follow(
+        self,
+        hand_in_object: Sequence[Pose],
+        *,
+        object_pose: Pose | None = None,
+        settle: float = 0.2,
+    ) -> float:
         """Move the hand through ``hand_in_object`` poses (object frame); returns the simulated duration.
 
         The object frame is taken from the tracker once, at the start (the
@@ -257,7 +306,10 @@ class TableRig:
         for t in targets[1:]:
             c = clearance(t, self.opening(), m.table_height)
             if c < m.min_clearance:
-                raise RigFailure("unreachable", f"a hand pose would put the gripper {c * 1e3:.1f} mm from the table")
+                raise RigFailure(
+                    "unreachable",
+                    f"a hand pose would put the gripper {c * 1e3:.1f} mm from the table",
+                )
         seg = []
         for a, b in zip(targets[:-1], targets[1:]):
             dpos = float(np.linalg.norm(b.p - a.p)) / m.translation_speed
@@ -266,9 +318,14 @@ class TableRig:
         total = float(sum(seg))
         if total <= 1e-9:
             return 0.0
-        duration = 1.875 * total  # quintic peak speed = 1.875 x mean speed: keep peaks at the set speeds
+        duration = (
+            1.875 * total
+        )  # quintic peak speed = 1.875 x mean speed: keep peaks at the set speeds
         knots = np.concatenate([[0.0], np.cumsum(seg)]) / total
-        slerps = [Slerp([0.0, 1.0], Rotation.concatenate([a.rotation, b.rotation])) for a, b in zip(targets[:-1], targets[1:])]
+        slerps = [
+            Slerp([0.0, 1.0], Rotation.concatenate([a.rotation, b.rotation]))
+            for a, b in zip(targets[:-1], targets[1:])
+        ]
         be, robot = self.backend, self.robot
         per = max(1, int(round(robot.control_period / be.config.timestep)))
         tick = per * be.config.timestep
@@ -302,11 +359,19 @@ class TableRig:
         """
         if self.body is None or getattr(self, "rest", None) is None:
             return
-        turned = math.degrees(float((self.backend.get_pose(self.body).rotation * self.rest.rotation.inv()).magnitude()))
+        turned = math.degrees(
+            float(
+                (self.backend.get_pose(self.body).rotation * self.rest.rotation.inv()).magnitude()
+            )
+        )
         if turned > self.config.motion.max_object_turn:
-            raise RigFailure("dropped", f"the object toppled on the table (turned {turned:.0f} deg)")
+            raise RigFailure(
+                "dropped", f"the object toppled on the table (turned {turned:.0f} deg)"
+            )
 
-    def servo(self, target: Pose, tolerance_m: float, tolerance_rad: float, max_tries: int) -> list[dict]:
+    def servo(
+        self, target: Pose, tolerance_m: float, tolerance_rad: float, max_tries: int
+    ) -> list[dict]:
         """Closed-loop correction towards ``target`` (hand pose, object frame) on the tracked object.
 
         While the measured grasp is off by more than the tolerances (and at
@@ -373,8 +438,11 @@ class TableRig:
         return pts
 
     def touching_table(self) -> bool:
-        return any(c.body_b != self.robot.body and c.normal_force > 0 for c in self.backend.contacts(self.body)
-                   if c.body_b != self.body and c.body_b != self.robot.body)
+        return any(
+            c.body_b != self.robot.body and c.normal_force > 0
+            for c in self.backend.contacts(self.body)
+            if c.body_b != self.body and c.body_b != self.robot.body
+        )
 
     # ------------------------------------------------------------------ protocol
     def setup_grasp(self, hand_in_object: Pose, width: float) -> Pose:
@@ -394,7 +462,10 @@ class TableRig:
         for pose in (pre, target):
             c = clearance(pose, opening, self.config.motion.table_height)
             if c < self.config.motion.min_clearance:
-                raise RigFailure("unreachable", f"the set-up grasp would put the gripper {c * 1e3:.1f} mm from the table")
+                raise RigFailure(
+                    "unreachable",
+                    f"the set-up grasp would put the gripper {c * 1e3:.1f} mm from the table",
+                )
         self.spawn_at(pre, opening)
         self.follow([noisy], object_pose=obj, settle=0.05)
         self.tighten()
@@ -423,7 +494,10 @@ class TableRig:
             if k % 12 == 0 or k == ticks - 1:  # every 0.1 s at the default control rate
                 rel = self.hand_in_object(noisy=False)
                 if np.linalg.norm(rel.p - start.p) > h.drop_distance:
-                    dropped, why = True, f"the object moved {np.linalg.norm(rel.p - start.p) * 100:.1f} cm from the hand"
+                    dropped, why = (
+                        True,
+                        f"the object moved {np.linalg.norm(rel.p - start.p) * 100:.1f} cm from the hand",
+                    )
                 elif not all(self.finger_contacts().values()):
                     dropped, why = True, "a finger lost contact with the object"
                 elif self.touching_table():
@@ -434,8 +508,14 @@ class TableRig:
         dpos = float(np.linalg.norm(after.p - before.p))
         dang = math.degrees(float((after.rotation * before.rotation.inv()).magnitude()))
         stable = (not dropped) and dpos < h.stable_position and dang < h.stable_angle
-        msg = why if dropped else (f"hold {h.hold_time:g} s: drift {dpos * 1e3:.2f} mm, {dang:.2f} deg"
-                                   + ("" if stable else " (not stable)"))
+        msg = (
+            why
+            if dropped
+            else (
+                f"hold {h.hold_time:g} s: drift {dpos * 1e3:.2f} mm, {dang:.2f} deg"
+                + ("" if stable else " (not stable)")
+            )
+        )
         lift_p = float(np.linalg.norm(before.p - start.p))
         lift_a = math.degrees(float((before.rotation * start.rotation.inv()).magnitude()))
         return HoldResult(stable, dropped, dpos, dang, msg, lift_p, lift_a)

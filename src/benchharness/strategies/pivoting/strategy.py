@@ -52,18 +52,29 @@ def run_pivots(rig: TableRig, target: Pose, cfg: PivotConfig, step_deg: float = 
     for k in range(cfg.max_pivots):
         now = rig.hand_in_object()
         err, off = grasp_axis_angle(now, target)
-        log.append({"pivot": k, "remaining_deg": math.degrees(err), "off_axis_deg": math.degrees(off)})
+        log.append(
+            {"pivot": k, "remaining_deg": math.degrees(err), "off_axis_deg": math.degrees(off)}
+        )
         if abs(err) <= cfg.tolerance_rad:
             break
         n = max(1, int(math.ceil(abs(math.degrees(err)) / step_deg)))
-        path = [Pose(now.p, (now.rotation * Rotation.from_rotvec([0.0, 0.0, err * j / n])).as_quat()) for j in range(1, n + 1)]
+        path = [
+            Pose(now.p, (now.rotation * Rotation.from_rotvec([0.0, 0.0, err * j / n])).as_quat())
+            for j in range(1, n + 1)
+        ]
         rig.loosen()
         rig.follow(path)
         rig.tighten()
     else:
         now = rig.hand_in_object()
         err, off = grasp_axis_angle(now, target)
-        log.append({"pivot": cfg.max_pivots, "remaining_deg": math.degrees(err), "off_axis_deg": math.degrees(off)})
+        log.append(
+            {
+                "pivot": cfg.max_pivots,
+                "remaining_deg": math.degrees(err),
+                "off_axis_deg": math.degrees(off),
+            }
+        )
     return log
 
 
@@ -88,21 +99,34 @@ class PivotingStrategy:
             keys = {" ".join(k.lower().split()): v for k, v in PIVOT_OBJECTS.items()}
             axis = keys.get(" ".join(str(item.object).lower().split()))
             if axis is None:
-                raise ValueError(f"task {item.task_id!r}: no grasp_axis column and no default grasp axis for {item.object!r}")
+                raise ValueError(
+                    f"task {item.task_id!r}: no grasp_axis column and no default grasp axis for {item.object!r}"
+                )
         else:
             axis = tuple(float(v) for v in str(axis_text).split())
         if getattr(ctx.robot, "name", "") != "pr2-gripper":
-            raise ValueError(f"the pivoting strategy drives the pr2-gripper robot, got {getattr(ctx.robot, 'name', ctx.robot)!r}")
+            raise ValueError(
+                f"the pivoting strategy drives the pr2-gripper robot, got {getattr(ctx.robot, 'name', ctx.robot)!r}"
+            )
         cfg = self.config
         ex = cfg.execution
         t0 = time.perf_counter()
         model = load_object(item.object, resolution=ex.resolution)
         rest_text = (item.extra or {}).get("rest_pose")
-        rest = (Pose.from_array([float(v) for v in str(rest_text).split()]) if rest_text
-                else rest_pose(item.object, axis, grasp_axis_angle(Pose.from_array(item.initial), Pose.from_array(item.desired))[0]))
+        rest = (
+            Pose.from_array([float(v) for v in str(rest_text).split()])
+            if rest_text
+            else rest_pose(
+                item.object,
+                axis,
+                grasp_axis_angle(Pose.from_array(item.initial), Pose.from_array(item.desired))[0],
+            )
+        )
         initial = Pose.from_array(item.initial)
         desired = Pose.from_array(item.desired)
-        width = float(np.ptp(np.asarray(model.surface.vertices) @ (np.asarray(axis) / np.linalg.norm(axis))))
+        width = float(
+            np.ptp(np.asarray(model.surface.vertices) @ (np.asarray(axis) / np.linalg.norm(axis)))
+        )
         plan_time = time.perf_counter() - t0  # the pivot "plan": targets from the task, rest pose
         rig = TableRig(ctx.backend, ctx.robot, model, ex, ctx.rng)
         rig.build(rest)
@@ -117,20 +141,36 @@ class PivotingStrategy:
             hold = rig.lift_and_hold()
             contacts = None if hold.dropped else rig.pad_contacts_object()
         except RigFailure as e:
-            return TrialOutcome(failure=e.cause, dropped=e.cause == "dropped", message=str(e),
-                                plan_time_s=plan_time, extra={"object": item.object})
+            return TrialOutcome(
+                failure=e.cause,
+                dropped=e.cause == "dropped",
+                message=str(e),
+                plan_time_s=plan_time,
+                extra={"object": item.object},
+            )
         reached = rig.hand_in_object()
-        extra = {"pivots": log, "hold": {"stable": hold.stable, "drift_mm": hold.drift_position * 1e3,
-                                         "drift_deg": hold.drift_angle_deg,
-                                         "lift_slip_mm": hold.lift_slip_position * 1e3, "lift_slip_deg": hold.lift_slip_angle_deg},
-                 "pivot_deg": math.degrees(grasp_axis_angle(initial, desired)[0]),
-                 "reached_pivot_deg": math.degrees(grasp_axis_angle(setup, reached)[0]),
-                 "final_about_axis_deg": math.degrees(grasp_axis_angle(reached, desired)[0]),
-                 "final_off_axis_deg": math.degrees(grasp_axis_angle(reached, desired)[1]),
-                 "contact_centroids": None if centroids is None else centroids.tolist()}
+        extra = {
+            "pivots": log,
+            "hold": {
+                "stable": hold.stable,
+                "drift_mm": hold.drift_position * 1e3,
+                "drift_deg": hold.drift_angle_deg,
+                "lift_slip_mm": hold.lift_slip_position * 1e3,
+                "lift_slip_deg": hold.lift_slip_angle_deg,
+            },
+            "pivot_deg": math.degrees(grasp_axis_angle(initial, desired)[0]),
+            "reached_pivot_deg": math.degrees(grasp_axis_angle(setup, reached)[0]),
+            "final_about_axis_deg": math.degrees(grasp_axis_angle(reached, desired)[0]),
+            "final_off_axis_deg": math.degrees(grasp_axis_angle(reached, desired)[1]),
+            "contact_centroids": None if centroids is None else centroids.tolist(),
+        }
         return TrialOutcome(
-            reached=None if hold.dropped else reached.as_array(), setup=setup.as_array(), dropped=hold.dropped,
-            plan_time_s=plan_time, exec_time_s=exec_time,
+            reached=None if hold.dropped else reached.as_array(),
+            setup=setup.as_array(),
+            dropped=hold.dropped,
+            plan_time_s=plan_time,
+            exec_time_s=exec_time,
             reached_contacts=None if contacts is None else contacts.tolist(),
-            message=hold.message, extra=extra,
+            message=hold.message,
+            extra=extra,
         )

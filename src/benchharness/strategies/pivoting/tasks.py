@@ -36,19 +36,32 @@ from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
 
-__all__ = ["PIVOT_OBJECTS", "GRASP_DEPTH", "MAX_WIDTH", "pivot_angle", "initial_grasp", "derive_pivot_tasks",
-           "write_pivot_tasks", "PIVOT_TASK_FILE"]
+__all__ = [
+    "PIVOT_OBJECTS",
+    "GRASP_DEPTH",
+    "MAX_WIDTH",
+    "pivot_angle",
+    "initial_grasp",
+    "derive_pivot_tasks",
+    "write_pivot_tasks",
+    "PIVOT_TASK_FILE",
+]
 
 #: object -> grasp (closing) axis in our object frame, chosen across two flat parallel faces
 PIVOT_OBJECTS = {"gelatin box": (1.0, 0.0, 0.0), "Lego Duplo": (0.0, 1.0, 0.0)}
-GRASP_DEPTH = 0.020  #: m, tool centre point below the object's top: the 35 mm pads' half length + 2.5 mm
+GRASP_DEPTH = (
+    0.020  #: m, tool centre point below the object's top: the 35 mm pads' half length + 2.5 mm
+)
 MAX_WIDTH = 0.080  #: m, PR2 gripper opening (90 mm) less 5 mm each side
 PIVOT_TASK_FILE = "level1_pivoting.csv"
 
 
 def pivot_angle(initial_q, desired_q) -> float:
     """Signed magnitude (rad) of the published relative rotation ``R_d R_i^-1`` (see module docstring)."""
-    rv = (Rotation.from_quat(np.asarray(desired_q, float)) * Rotation.from_quat(np.asarray(initial_q, float)).inv()).as_rotvec()
+    rv = (
+        Rotation.from_quat(np.asarray(desired_q, float))
+        * Rotation.from_quat(np.asarray(initial_q, float)).inv()
+    ).as_rotvec()
     ang = float(np.linalg.norm(rv))
     return ang if ang == 0.0 else ang * float(np.sign(rv[int(np.argmax(np.abs(rv)))]))
 
@@ -62,13 +75,20 @@ def rest_pose(obj: str, grasp_axis, pivot: float = 0.0) -> Pose:
 
     model = load_object(obj)
     rests = stable_rest_poses(model.surface, model.mass.com, grasp_axis)
-    width = float(np.ptp(np.asarray(model.surface.vertices) @ (np.asarray(grasp_axis, float) / np.linalg.norm(grasp_axis))))
+    width = float(
+        np.ptp(
+            np.asarray(model.surface.vertices)
+            @ (np.asarray(grasp_axis, float) / np.linalg.norm(grasp_axis))
+        )
+    )
     for rest in rests:
         hi = initial_grasp(obj, grasp_axis, pivot, rest)
         hd = hi * Pose.from_rotation(np.zeros(3), Rotation.from_rotvec([0.0, 0.0, pivot]))
         if min(clearance(rest * h, width + 0.03) for h in (hi, hd)) >= MotionConfig().min_clearance:
             return rest
-    raise ValueError(f"{obj}: no stable rest pose keeps the grasp axis {grasp_axis} horizontal with the gripper clear of the table")
+    raise ValueError(
+        f"{obj}: no stable rest pose keeps the grasp axis {grasp_axis} horizontal with the gripper clear of the table"
+    )
 
 
 def initial_grasp(obj: str, grasp_axis, pivot: float, rest: Pose | None = None) -> Pose:
@@ -82,11 +102,15 @@ def initial_grasp(obj: str, grasp_axis, pivot: float, rest: Pose | None = None) 
     top = float(verts[:, 2].max())
     width = float(np.ptp(np.asarray(model.surface.vertices) @ a))
     if width > MAX_WIDTH:
-        raise ValueError(f"{obj}: {width * 1e3:.0f} mm across the grasp axis, more than the {MAX_WIDTH * 1e3:.0f} mm allowed")
+        raise ValueError(
+            f"{obj}: {width * 1e3:.0f} mm across the grasp axis, more than the {MAX_WIDTH * 1e3:.0f} mm allowed"
+        )
     centre = rest.p  # the object frame's origin (bounding-box centre) in the world
     z = rest.rotation.apply(a)  # closing direction, horizontal
     x = np.array([0.0, 0.0, -1.0])  # fingers pointing down ...
-    x = Rotation.from_rotvec(z * (-pivot / 2)).apply(x)  # ... tilted by -pivot/2 about the grasp axis
+    x = Rotation.from_rotvec(z * (-pivot / 2)).apply(
+        x
+    )  # ... tilted by -pivot/2 about the grasp axis
     y = np.cross(z, x)
     tcp = np.array([centre[0], centre[1], top - GRASP_DEPTH])
     hand_world = Pose.from_rotation(tcp, Rotation.from_matrix(np.column_stack([x, y, z])))
@@ -99,7 +123,9 @@ def derive_pivot_tasks(level1_path: str | Path | None = None):
     from ...inhand.records import TaskSet
     from ...paths import tasks_dir
 
-    src = read_tasks(Path(level1_path) if level1_path else tasks_dir() / "inhand" / "level1_hand_poses.csv")
+    src = read_tasks(
+        Path(level1_path) if level1_path else tasks_dir() / "inhand" / "level1_hand_poses.csv"
+    )
     keys = {" ".join(k.lower().split()): k for k in PIVOT_OBJECTS}
     rows = []
     for i in range(len(src)):
@@ -112,7 +138,18 @@ def derive_pivot_tasks(level1_path: str | Path | None = None):
         rest = rest_pose(obj, axis, pivot)
         hi = initial_grasp(obj, axis, pivot, rest)
         hd = hi * Pose.from_rotation(np.zeros(3), Rotation.from_rotvec([0.0, 0.0, pivot]))
-        rows.append((f"{src.task_id[i]}-pivot", obj, hi.as_array(), hd.as_array(), str(src.task_id[i]), pivot, axis, rest))
+        rows.append(
+            (
+                f"{src.task_id[i]}-pivot",
+                obj,
+                hi.as_array(),
+                hd.as_array(),
+                str(src.task_id[i]),
+                pivot,
+                axis,
+                rest,
+            )
+        )
     n = len(rows)
     return TaskSet(
         task_id=np.array([r[0] for r in rows], dtype=object),
@@ -124,7 +161,10 @@ def derive_pivot_tasks(level1_path: str | Path | None = None):
             "source_task": np.array([r[4] for r in rows], dtype=object),
             "pivot_deg": np.array([f"{math.degrees(r[5]):.4f}" for r in rows], dtype=object),
             "grasp_axis": np.array([" ".join(f"{v:g}" for v in r[6]) for r in rows], dtype=object),
-            "rest_pose": np.array([" ".join(f"{v:.6g}" for v in np.round(r[7].as_array(), 9) + 0.0) for r in rows], dtype=object),
+            "rest_pose": np.array(
+                [" ".join(f"{v:.6g}" for v in np.round(r[7].as_array(), 9) + 0.0) for r in rows],
+                dtype=object,
+            ),
             "set": np.array(["pivoting-level1"] * n, dtype=object),
         },
     )

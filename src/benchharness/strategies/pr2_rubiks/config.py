@@ -72,5 +72,5 @@ class PR2RubiksConfig:
     max_actions: int | None = None
     errors: ErrorConfig = ErrorConfig()
 
-    def zero_error(self) -> "PR2RubiksConfig":
+    def zero_error(self) -> PR2RubiksConfig:
         return replace(self, errors=self.errors.zero())

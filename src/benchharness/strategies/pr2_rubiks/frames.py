@@ -29,10 +29,15 @@ __all__ = [
 ]
 
 DIRECTIONS: dict[str, np.ndarray] = {
-    "+x": np.array([1.0, 0.0, 0.0]), "-x": np.array([-1.0, 0.0, 0.0]),
-    "+y": np.array([0.0, 1.0, 0.0]), "-y": np.array([0.0, -1.0, 0.0]),
-    "+z": np.array([0.0, 0.0, 1.0]), "-z": np.array([0.0, 0.0, -1.0]),
-    "x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0]),
+    "+x": np.array([1.0, 0.0, 0.0]),
+    "-x": np.array([-1.0, 0.0, 0.0]),
+    "+y": np.array([0.0, 1.0, 0.0]),
+    "-y": np.array([0.0, -1.0, 0.0]),
+    "+z": np.array([0.0, 0.0, 1.0]),
+    "-z": np.array([0.0, 0.0, -1.0]),
+    "x": np.array([1.0, 0.0, 0.0]),
+    "y": np.array([0.0, 1.0, 0.0]),
+    "z": np.array([0.0, 0.0, 1.0]),
 }
 
 
@@ -49,7 +54,9 @@ def body_axis_along(cube: Pose, world_dir: str | np.ndarray) -> np.ndarray:
     return out
 
 
-def grip_pose(cube: Pose, world_dir: str | np.ndarray, offset: float, fingers: str | np.ndarray) -> Pose:
+def grip_pose(
+    cube: Pose, world_dir: str | np.ndarray, offset: float, fingers: str | np.ndarray
+) -> Pose:
     """Tool-frame target of a grip from ``world_dir``, ``offset`` m from the centre, fingers along ``fingers``.
 
     ``fingers`` is a world direction; the body axis perpendicular to the
@@ -81,7 +88,9 @@ def grip_candidates(cube: Pose, world_dir: str | np.ndarray, offset: float) -> l
     return out
 
 
-def rotate_about_point(pose: Pose, centre: np.ndarray, axis: str | np.ndarray, angle: float) -> Pose:
+def rotate_about_point(
+    pose: Pose, centre: np.ndarray, axis: str | np.ndarray, angle: float
+) -> Pose:
     """``pose`` carried rigidly by a rotation of ``angle`` rad about world ``axis`` through ``centre``."""
     r = Rotation.from_rotvec(_vec(axis) * angle)
     c = np.asarray(centre, dtype=float)

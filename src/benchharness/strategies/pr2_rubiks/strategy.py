@@ -23,7 +23,17 @@ from scipy.spatial.transform import Rotation
 from ...backends.interface import Box
 from ...geometry import Pose
 from ...runner.contract import TrialContext, TrialOutcome
-from ..regrasp import HandModel, Handover, Pick, Regrasp, Release, Twist, execute, plan_sequence, twist_move
+from ..regrasp import (
+    HandModel,
+    Handover,
+    Pick,
+    Regrasp,
+    Release,
+    Twist,
+    execute,
+    plan_sequence,
+    twist_move,
+)
 from .config import PR2RubiksConfig
 from .frames import DIRECTIONS, grip_candidates, rotate_about_point, turned_about_approach
 
@@ -54,7 +64,9 @@ class Hand:
     holding: bool = False
     cube_in_tcp: Pose | None = None  #: believed cube pose in the commanded tool frame
     grip_dir: str | None = None  #: world direction the hand grips from ("+y", "-x", ...)
-    last_grip: Pose | None = None  #: the commanded tool pose of the last grip (retreats go back from it)
+    last_grip: Pose | None = (
+        None  #: the commanded tool pose of the last grip (retreats go back from it)
+    )
     depth: int = 0
     log: list = field(default_factory=list)
 
@@ -84,11 +96,18 @@ class DeadReckoningStrategy:
         b.add_ground()
         h = cfg.table_height
         tx, ty = cfg.table_half_size
-        b.add_body([Box((tx, ty, h / 2))], Pose([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]), 1.0,
-                   fixed=True, name="table")
+        b.add_body(
+            [Box((tx, ty, h / 2))],
+            Pose([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]),
+            1.0,
+            fixed=True,
+            name="table",
+        )
         # protocol: top face up, F facing the robot (body -y -> world -x: yaw -90 deg)
-        true0 = Pose.from_rotation([cfg.cube_xy[0], cfg.cube_xy[1], h + CUBE_HALF + 5e-4],
-                                   Rotation.from_euler("z", -90, degrees=True))
+        true0 = Pose.from_rotation(
+            [cfg.cube_xy[0], cfg.cube_xy[1], h + CUBE_HALF + 5e-4],
+            Rotation.from_euler("z", -90, degrees=True),
+        )
         self.cube = cube = PhysicalCube(b, true0)
         robot = ctx.robot
         robot.spawn(b)
@@ -112,9 +131,17 @@ class DeadReckoningStrategy:
         self.hands = {}
         for side in ("left", "right"):
             dp = rng.normal(0.0, err.calib_pos_std, 3) if err.calib_pos_std else np.zeros(3)
-            dr = rng.normal(0.0, math.radians(err.calib_rot_std_deg), 3) if err.calib_rot_std_deg else np.zeros(3)
-            self.hands[side] = Hand(side, self.robot.arm(f"{side}_arm"), self.robot.gripper(f"{side}_gripper"),
-                                    Pose.from_rotation(dp, Rotation.from_rotvec(dr)))
+            dr = (
+                rng.normal(0.0, math.radians(err.calib_rot_std_deg), 3)
+                if err.calib_rot_std_deg
+                else np.zeros(3)
+            )
+            self.hands[side] = Hand(
+                side,
+                self.robot.arm(f"{side}_arm"),
+                self.robot.gripper(f"{side}_gripper"),
+                Pose.from_rotation(dp, Rotation.from_rotvec(dr)),
+            )
         for hnd in self.hands.values():
             hnd.cmd = hnd.arm.tcp_pose()
         self.robot.settle(0.2)
@@ -125,8 +152,14 @@ class DeadReckoningStrategy:
         model = HandModel(name="pr2", pick_approaches=tuple(cfg.pick_approaches))
         plan = plan_sequence(ctx.item.sequence, model)
         trace = execute(plan).orientations
-        rec.event("plan", actions=len(plan.actions), twists=plan.twists, regrasps=plan.regrasps,
-                  handovers=plan.handovers, text=plan.describe())
+        rec.event(
+            "plan",
+            actions=len(plan.actions),
+            twists=plan.twists,
+            regrasps=plan.regrasps,
+            handovers=plan.handovers,
+            text=plan.describe(),
+        )
         self.plan, self.trace = plan, trace
         move_index = 0
         try:
@@ -153,20 +186,36 @@ class DeadReckoningStrategy:
                     self._check_drop(k)
                     # after the release the cube lies on the table and nothing believes where:
                     # logging that estimate would plot as a 7 cm "error" at the last move
-                    rec.pose_estimate(move_index, self.cube.pose(), self.est, label=type(action).__name__.lower())
+                    rec.pose_estimate(
+                        move_index, self.cube.pose(), self.est, label=type(action).__name__.lower()
+                    )
         except StrategyFailure as e:
             rec.event("failure", cause=e.cause, message=str(e))
             t_end = b.time
             if e.cause is None:
-                return TrialOutcome(final_state=self.cube.state_string, termination_s=t_end, message=str(e),
-                                    extra=self._extra())
-            return TrialOutcome(failure=e.cause, message=str(e), termination_s=t_end,
-                                final_state=None, extra=self._extra())
-        return TrialOutcome(final_state=self.cube.state_string, termination_s=self.t_release, extra=self._extra())
+                return TrialOutcome(
+                    final_state=self.cube.state_string,
+                    termination_s=t_end,
+                    message=str(e),
+                    extra=self._extra(),
+                )
+            return TrialOutcome(
+                failure=e.cause,
+                message=str(e),
+                termination_s=t_end,
+                final_state=None,
+                extra=self._extra(),
+            )
+        return TrialOutcome(
+            final_state=self.cube.state_string, termination_s=self.t_release, extra=self._extra()
+        )
 
     def _extra(self) -> dict:
-        return {"twists": [o.summary() for o in self.cube.history], "misaligned": self.cube.misaligned,
-                "errors": {s: h.calibration.as_array().tolist() for s, h in self.hands.items()}}
+        return {
+            "twists": [o.summary() for o in self.cube.history],
+            "misaligned": self.cube.misaligned,
+            "errors": {s: h.calibration.as_array().tolist() for s, h in self.hands.items()},
+        }
 
     # ------------------------------------------------------------- sensing
     def _camera_estimate(self, ctx: TrialContext) -> Pose:
@@ -179,7 +228,9 @@ class DeadReckoningStrategy:
             from ...sensors import HeadCamera
         except ImportError:  # sensors package absent: a documented Gaussian from ctx.rng
             p = true.p + ctx.rng.normal(0.0, err.camera_pos_std, 3)
-            yaw = Rotation.from_euler("z", ctx.rng.normal(0.0, err.camera_yaw_std_deg), degrees=True)
+            yaw = Rotation.from_euler(
+                "z", ctx.rng.normal(0.0, err.camera_yaw_std_deg), degrees=True
+            )
             return Pose.from_rotation(p, yaw * true.rotation)
         cam = slot.create() if slot is not None else HeadCamera()
         rng = slot.rng if slot is not None else ctx.rng
@@ -188,8 +239,13 @@ class DeadReckoningStrategy:
     def _check_drop(self, k: int) -> None:
         """Judge's check (not control): the cube far from where it is believed and below the hands."""
         true = self.cube.pose()
-        if true.p[2] < self.config.table_height + CUBE_HALF + 0.01 and np.linalg.norm(true.p - self.est.p) > self.config.drop_distance:
-            raise StrategyFailure("dropped", f"action {k + 1}: the cube fell (at {np.round(true.p, 3).tolist()})")
+        if (
+            true.p[2] < self.config.table_height + CUBE_HALF + 0.01
+            and np.linalg.norm(true.p - self.est.p) > self.config.drop_distance
+        ):
+            raise StrategyFailure(
+                "dropped", f"action {k + 1}: the cube fell (at {np.round(true.p, 3).tolist()})"
+            )
 
     def _judge(self, label: str, hand: Hand | None = None) -> None:
         """Diagnostic event (not control): how far the true cube is from the belief right now.
@@ -199,29 +255,48 @@ class DeadReckoningStrategy:
         """
         true = self.cube.pose()
         rv = (true.rotation * self.est.rotation.inv()).as_rotvec()
-        data = {"label": label, "err_mm": round(float(1000 * np.linalg.norm(true.p - self.est.p)), 2),
-                "rot_deg": np.round(np.degrees(rv), 1).tolist()}
+        data = {
+            "label": label,
+            "err_mm": round(float(1000 * np.linalg.norm(true.p - self.est.p)), 2),
+            "rot_deg": np.round(np.degrees(rv), 1).tolist(),
+        }
         if hand is not None and hand.cmd is not None:
             data["hand"] = hand.side
             data["fingers"] = np.round(hand.cmd.rotation.apply([0.0, 1.0, 0.0]), 2).tolist()
         self.ctx.recorder.event("check", **data)
 
     # ------------------------------------------------------------- motion
-    def _send(self, hand: Hand, target: Pose, *, label: str, duration: float | None = None,
-              settle: float = 0.2, seed_q: np.ndarray | None = None) -> None:
+    def _send(
+        self,
+        hand: Hand,
+        target: Pose,
+        *,
+        label: str,
+        duration: float | None = None,
+        settle: float = 0.2,
+        seed_q: np.ndarray | None = None,
+    ) -> None:
         """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors."""
         err = self.config.errors
         noise = self.ctx.rng.normal(0.0, err.tracking_std, 3) if err.tracking_std else np.zeros(3)
         cal = hand.calibration
         actual = Pose.from_rotation(target.p + cal.p + noise, cal.rotation * target.rotation)
-        res = hand.arm.move_to_pose(actual, duration=duration, velocity_scale=self.config.velocity_scale,
-                                    settle=settle, seed_q=seed_q)
+        res = hand.arm.move_to_pose(
+            actual,
+            duration=duration,
+            velocity_scale=self.config.velocity_scale,
+            settle=settle,
+            seed_q=seed_q,
+        )
         hand.cmd = target
         if hand.holding:
             hand.last_grip = target
         if not res.ik_success:
-            raise StrategyFailure("unreachable", f"{hand.side} arm: no IK solution for {label} "
-                                  f"(target {np.round(target.p, 3).tolist()})")
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: no IK solution for {label} "
+                f"(target {np.round(target.p, 3).tolist()})",
+            )
         if hand.holding and not self._other(hand).holding and hand.cube_in_tcp is not None:
             self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
 
@@ -231,8 +306,15 @@ class DeadReckoningStrategy:
     def _offset(self, depth: int) -> float:
         return self.config.rotator_offset if depth == 1 else self.config.holder_offset
 
-    def _choose_grip(self, hand: Hand, world_dir: str, depth: int, vertical_fingers: bool = True,
-                     turn: tuple[str, float] | None = None, perpendicular: bool = False) -> tuple[Pose, np.ndarray]:
+    def _choose_grip(
+        self,
+        hand: Hand,
+        world_dir: str,
+        depth: int,
+        vertical_fingers: bool = True,
+        turn: tuple[str, float] | None = None,
+        perpendicular: bool = False,
+    ) -> tuple[Pose, np.ndarray]:
         """The grip (of four finger placements) the arm reaches with the least joint motion, and its IK solution.
 
         The PR2's forearm and wrist rolls are continuous and IK returns them on
@@ -250,11 +332,21 @@ class DeadReckoningStrategy:
         All placements are solved in one batched IK call (and the turn's waypoints in one call each).
         """
         other = self._other(hand)
-        other_y = other.last_grip.rotation.apply([0.0, 1.0, 0.0]) if other.holding and other.last_grip else None
-        other_x = other.last_grip.rotation.apply([1.0, 0.0, 0.0]) if other.holding and other.last_grip else None
+        other_y = (
+            other.last_grip.rotation.apply([0.0, 1.0, 0.0])
+            if other.holding and other.last_grip
+            else None
+        )
+        other_x = (
+            other.last_grip.rotation.apply([1.0, 0.0, 0.0])
+            if other.holding and other.last_grip
+            else None
+        )
         # a giver whose fingers ended on the work axis has a pad on the face this hand comes to: this
         # hand's pads must then also stay off the faces the giver approaches along
-        other_on_axis = other_y is not None and abs(float(np.dot(other_y, DIRECTIONS[world_dir]))) > 0.7
+        other_on_axis = (
+            other_y is not None and abs(float(np.dot(other_y, DIRECTIONS[world_dir]))) > 0.7
+        )
         base = hand.arm.base_pose()
         q_now = hand.arm.positions()
         poses, bonus = [], []
@@ -274,7 +366,10 @@ class DeadReckoningStrategy:
             else:
                 bonus.append(0.5 if cross else 0.0)
         if not poses:
-            raise StrategyFailure("unreachable", f"{hand.side} arm: no finger placement from {world_dir} clears the other hand")
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: no finger placement from {world_dir} clears the other hand",
+            )
         seeds = [q_now]
         if turn is not None and self.giver_seeds > 0:
             # a giver also tries other arm configurations (the 7-DOF arm's self-motion) for each
@@ -282,31 +377,46 @@ class DeadReckoningStrategy:
             rng = np.random.default_rng(len(self.ctx.recorder.events))  # deterministic per trial
             lo = np.where(np.isfinite(hand.arm.lower), hand.arm.lower, -np.inf)
             hi = np.where(np.isfinite(hand.arm.upper), hand.arm.upper, np.inf)
-            seeds += [np.clip(q_now + rng.normal(0.0, 0.6, q_now.shape), lo, hi) for _ in range(self.giver_seeds)]
+            seeds += [
+                np.clip(q_now + rng.normal(0.0, 0.6, q_now.shape), lo, hi)
+                for _ in range(self.giver_seeds)
+            ]
         poses = [p for p in poses for _ in seeds]
         bonus = [b for b in bonus for _ in seeds]
         seed_rows = np.stack([q for _ in range(len(poses) // len(seeds)) for q in seeds])
         res = hand.arm.ik(np.stack([(base.inv() * p).as_matrix() for p in poses]), seed_q=seed_rows)
         ok = np.asarray(res.success, dtype=bool)
         if not ok.any():
-            raise StrategyFailure("unreachable", f"{hand.side} arm: no grip from {world_dir} reachable")
-        score = np.array([-0.1 * float(np.max(np.abs(res.q[i] - q_now))) + bonus[i] for i in range(len(poses))])
+            raise StrategyFailure(
+                "unreachable", f"{hand.side} arm: no grip from {world_dir} reachable"
+            )
+        score = np.array(
+            [-0.1 * float(np.max(np.abs(res.q[i] - q_now))) + bonus[i] for i in range(len(poses))]
+        )
         score[~ok] = -np.inf
         if turn is not None:
-            travel, worst = self._turn_travel(hand, base, [poses[i] for i in np.flatnonzero(ok)], res.q[ok], *turn)
+            travel, worst = self._turn_travel(
+                hand, base, [poses[i] for i in np.flatnonzero(ok)], res.q[ok], *turn
+            )
             turned = score.copy()
-            turned[np.flatnonzero(ok)] -= 0.1 * travel  # inf travel: the turn cannot be carried from there
+            turned[np.flatnonzero(ok)] -= (
+                0.1 * travel
+            )  # inf travel: the turn cannot be carried from there
             if np.isfinite(turned).any():
                 score = turned
             else:  # the least bad: the smallest largest jump on the way
                 score[np.flatnonzero(ok)] -= worst
-                self.ctx.recorder.event("warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly "
-                                        f"(largest joint step {float(np.min(worst)):.2f} rad)")
+                self.ctx.recorder.event(
+                    "warning",
+                    message=f"{hand.side}: no grip lets the hand-over turn run smoothly "
+                    f"(largest joint step {float(np.min(worst)):.2f} rad)",
+                )
         best = int(np.argmax(score))
         return poses[best], np.array(res.q[best], dtype=float)
 
-    def _turn_travel(self, hand: Hand, base: Pose, grips: list[Pose], q: np.ndarray, axis: str,
-                     angle: float) -> tuple[np.ndarray, np.ndarray]:
+    def _turn_travel(
+        self, hand: Hand, base: Pose, grips: list[Pose], q: np.ndarray, axis: str, angle: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Joint travel of carrying the cube from each of ``grips`` through the hand-over turn (inf: not
         smooth), and the largest joint step on the way (inf: a waypoint out of reach).
 
@@ -322,9 +432,14 @@ class DeadReckoningStrategy:
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
-            poses = [rotate_about_point(grips[k], self.est.p, axis, angle * min(i, n) / n) for k in live]
+            poses = [
+                rotate_about_point(grips[k], self.est.p, axis, angle * min(i, n) / n) for k in live
+            ]
             if i > n:  # the retreat
-                poses = [Pose(p.p - p.rotation.apply([self.handover_retreat, 0.0, 0.0]), p.q) for p in poses]
+                poses = [
+                    Pose(p.p - p.rotation.apply([self.handover_retreat, 0.0, 0.0]), p.q)
+                    for p in poses
+                ]
             targets = [(base.inv() * p).as_matrix() for p in poses]
             res = hand.arm.ik(np.stack(targets), seed_q=q[live])
             jump = np.max(np.abs(res.q - q[live]), axis=1)
@@ -337,14 +452,16 @@ class DeadReckoningStrategy:
 
     def _next_turn(self, k: int, side: str) -> tuple[str, float] | None:
         """If ``side``'s next regrasp after action ``k`` is giving the cube in a hand-over: (axis, angle)."""
-        for a in self.plan.actions[k + 1:]:
+        for a in self.plan.actions[k + 1 :]:
             if isinstance(a, Handover):
                 return (a.axis, a.quarter_turns * math.pi / 2) if a.giver == side else None
             if isinstance(a, Regrasp):
                 return None
         return None
 
-    def _approach(self, hand: Hand, grip: Pose, label: str, q_plan: np.ndarray | None = None) -> None:
+    def _approach(
+        self, hand: Hand, grip: Pose, label: str, q_plan: np.ndarray | None = None
+    ) -> None:
         """Open, go to the pre-grasp stand-off along the approach, move in, close.
 
         ``q_plan``: the grip's IK solution the choice was made with (and a
@@ -357,7 +474,10 @@ class DeadReckoningStrategy:
         hand.gripper.open(wait=0.3)
         cfg = self.config
         far = Pose(grip.p - grip.rotation.apply([cfg.far_distance, 0, 0]), grip.q)
-        if np.linalg.norm(far.p - hand.cmd.p) > 0.01 or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999:
+        if (
+            np.linalg.norm(far.p - hand.cmd.p) > 0.01
+            or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999
+        ):
             # swing round to the far stand-off first, so that the swing clears the cube
             self._swing(hand, far, label=f"{label} stand-off", seed_q=q_plan)
         back = Pose(grip.p - grip.rotation.apply([cfg.pregrasp_distance, 0, 0]), grip.q)
@@ -401,7 +521,9 @@ class DeadReckoningStrategy:
             f = i / n
             u = Rotation.from_rotvec(axis * angle * f).apply(u0)
             way = Pose.from_rotation(c + ((1 - f) * r0 + f * r1) * u, slerp([f])[0])
-            if hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()).success[0]:
+            if hand.arm.ik(
+                (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
+            ).success[0]:
                 self._send(hand, way, label=f"{label} arc", settle=0.02)
         self._send(hand, far, label=label, settle=0.05, seed_q=seed_q)
 
@@ -425,7 +547,9 @@ class DeadReckoningStrategy:
             hand.gripper.close(force_limit=cfg.soft_grip_force, obj=self.cube.body)
         g = hand.gripper.close(force_limit=cfg.grip_force, obj=self.cube.body)
         if g.closed or not g.contact:
-            raise StrategyFailure(None, f"{label}: {hand.side} gripper closed on nothing (grasp missed)")
+            raise StrategyFailure(
+                None, f"{label}: {hand.side} gripper closed on nothing (grasp missed)"
+            )
         hand.holding = True
         hand.last_grip = hand.cmd
         hand.cube_in_tcp = hand.cmd.inv() * self.est
@@ -450,34 +574,54 @@ class DeadReckoningStrategy:
         d = self.config.pregrasp_distance if retreat is None else retreat
         ref = hand.last_grip or hand.cmd
         back = Pose(ref.p - ref.rotation.apply([d, 0, 0]), ref.q)
-        if not (np.linalg.norm(back.p - hand.cmd.p) > 2e-3
-                or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)):
+        if not (
+            np.linalg.norm(back.p - hand.cmd.p) > 2e-3
+            or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)
+        ):
             return
         if self._smooth(hand, back):
             self._send(hand, back, label="retreat", settle=0.05)
             return
         step = 0.02
-        dist = float(np.dot(ref.p - hand.cmd.p, ref.rotation.apply([1.0, 0.0, 0.0])))  # already backed off
+        dist = float(
+            np.dot(ref.p - hand.cmd.p, ref.rotation.apply([1.0, 0.0, 0.0]))
+        )  # already backed off
         while dist + step <= d + 1e-9:
             nxt = Pose(ref.p - ref.rotation.apply([dist + step, 0, 0]), ref.q)
             if not self._smooth(hand, nxt):
                 break
             self._send(hand, nxt, label="retreat step", settle=0.02)
             dist += step
-        self.ctx.recorder.event("warning", message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
-                                f"(the straight way out leaves the arm's branch)")
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
+            f"(the straight way out leaves the arm's branch)",
+        )
 
     def _smooth(self, hand: Hand, target: Pose) -> bool:
         """Whether the arm reaches ``target`` from its joints without any joint moving > max_waypoint_jump."""
         base = hand.arm.base_pose()
         q = hand.arm.positions()
         res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
-        return bool(res.success[0]) and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
+        return (
+            bool(res.success[0])
+            and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
+        )
 
-    def _grip(self, hand: Hand, world_dir: str, depth: int, label: str, vertical_fingers: bool = True,
-              k: int | None = None, perpendicular: bool = False) -> None:
+    def _grip(
+        self,
+        hand: Hand,
+        world_dir: str,
+        depth: int,
+        label: str,
+        vertical_fingers: bool = True,
+        k: int | None = None,
+        perpendicular: bool = False,
+    ) -> None:
         turn = self._next_turn(k, hand.side) if (k is not None and depth == 2) else None
-        grip, q_plan = self._choose_grip(hand, world_dir, depth, vertical_fingers, turn, perpendicular)
+        grip, q_plan = self._choose_grip(
+            hand, world_dir, depth, vertical_fingers, turn, perpendicular
+        )
         self._approach(hand, grip, label, q_plan)
         self._close(hand, world_dir, depth, label)
 
@@ -490,7 +634,9 @@ class DeadReckoningStrategy:
     # ------------------------------------------------------------- actions
     def _pick(self, a: Pick, k: int) -> None:
         if a.approach != "side":
-            raise StrategyFailure(None, f"pick approach {a.approach!r} is not implemented (side only)")
+            raise StrategyFailure(
+                None, f"pick approach {a.approach!r} is not implemented (side only)"
+            )
         cfg = self.config
         picker = self.hands[a.gripper]
         other = self._other(picker)
@@ -503,7 +649,9 @@ class DeadReckoningStrategy:
         self._send(picker, there, label="carry")
         self._join(picker, other, a.rotator, "second grasp", "pick shift out", k)
 
-    def _join(self, alone: Hand, free: Hand, rotator: str, label: str, shift_label: str, k: int) -> None:
+    def _join(
+        self, alone: Hand, free: Hand, rotator: str, label: str, shift_label: str, k: int
+    ) -> None:
         """The free hand joins the hand holding alone (two slabs deep) so that the next rotator holds one slab.
 
         If the lone holder rotates next, the free hand grips two slabs deep, fingers crossing (it
@@ -539,18 +687,33 @@ class DeadReckoningStrategy:
         delta = self._roll_delta(t)
         q = rot.arm.positions().copy()
         q[-1] += delta  # the wrist roll is continuous: any twist runs in full
-        rot.arm.move_to_joints(q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2)
+        rot.arm.move_to_joints(
+            q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2
+        )
         rot.cmd = rot.last_grip = turned_about_approach(rot.cmd, delta)
         rot.gripper.open(wait=0.3)
         out = cube.end_twist()
-        rec.move(t.source, str(move), outcome=out.summary(), moves=out.moves, layer_angles_deg=list(out.layer_angles_deg),
-                 jammed=out.jammed, misaligned=out.misaligned, as_intended=out.as_intended, body_axis=body_axis)
+        rec.move(
+            t.source,
+            str(move),
+            outcome=out.summary(),
+            moves=out.moves,
+            layer_angles_deg=list(out.layer_angles_deg),
+            jammed=out.jammed,
+            misaligned=out.misaligned,
+            as_intended=out.as_intended,
+            body_axis=body_axis,
+        )
         if out.unintended_rotation:
-            rec.unintended_rotation(t.source, str(move), out.moves or "misaligned", dragged_deg=out.dragged_deg)
+            rec.unintended_rotation(
+                t.source, str(move), out.moves or "misaligned", dragged_deg=out.dragged_deg
+            )
         if out.jammed:
             rec.blocked_rotation(t.source, str(move), "the turning layer did not turn (jammed)")
             raise StrategyFailure("jammed", f"twist {k + 1} ({move}) jammed: {out.summary()}")
-        self._release_hand(rot)  # the rotator backs off; the next regrasp or hand-over takes it from there
+        self._release_hand(
+            rot
+        )  # the rotator backs off; the next regrasp or hand-over takes it from there
 
     def _shift(self, a: Regrasp, k: int) -> None:
         if a.kind != "shift":
@@ -572,8 +735,12 @@ class DeadReckoningStrategy:
         angle = a.quarter_turns * math.pi / 2
         start = giver.cmd
         for i in range(1, n + 1):
-            self._send(giver, rotate_about_point(start, centre, a.axis, angle * i / n), label="hand-over turn",
-                       settle=0.05 if i < n else 0.2)
+            self._send(
+                giver,
+                rotate_about_point(start, centre, a.axis, angle * i / n),
+                label="hand-over turn",
+                settle=0.05 if i < n else 0.2,
+            )
         self._judge("hand-over turned", giver)
         # The taker takes two slabs deep, whichever hand rotates next: it then holds the cube alone
         # while the giver comes round, and a one-slab grip (12 mm of pad on the face, the weight 34 mm
@@ -623,7 +790,9 @@ class SensorAidedStrategy(DeadReckoningStrategy):
             link = hand.arm.config.tcp_link
             slot = self.ctx.sensors.get("pretouch-tof") if self.ctx.sensors else None
             if slot is not None:
-                sensor = slot.create(backend=self.b, body=self.robot.body, link=link, emitters=emitters)
+                sensor = slot.create(
+                    backend=self.b, body=self.robot.body, link=link, emitters=emitters
+                )
                 rng = slot.rng
             else:
                 sensor = PreTouchSensor(self.b, self.robot.body, link, emitters)
@@ -644,13 +813,23 @@ class SensorAidedStrategy(DeadReckoningStrategy):
         if report.n_used >= 3:
             post = kf.estimate
             dyaw = yaw_error(post.yaw, cube_yaw(before.rotation))
-            self.est = Pose.from_rotation(post.pose.p, Rotation.from_euler("z", dyaw) * before.rotation)
+            self.est = Pose.from_rotation(
+                post.pose.p, Rotation.from_euler("z", dyaw) * before.rotation
+            )
             for h in self.hands.values():  # re-anchor what the holding hand believes it carries
                 if h.holding and h.cmd is not None:
                     h.cube_in_tcp = h.cmd.inv() * self.est
-        self.ctx.recorder.event("pretouch", hand=hand.side, label=label, rays=report.n_rays, used=report.n_used,
-                                correction_mm=float(1000 * np.linalg.norm(self.est.p - before.p)))
-        self.ctx.recorder.pose_estimate(getattr(self, "_move_index", 0), self.cube.pose(), self.est, label="pretouch")
+        self.ctx.recorder.event(
+            "pretouch",
+            hand=hand.side,
+            label=label,
+            rays=report.n_rays,
+            used=report.n_used,
+            correction_mm=float(1000 * np.linalg.norm(self.est.p - before.p)),
+        )
+        self.ctx.recorder.pose_estimate(
+            getattr(self, "_move_index", 0), self.cube.pose(), self.est, label="pretouch"
+        )
         if self.est is before:
             return grip
         # the same finger placement, recomputed from the corrected belief

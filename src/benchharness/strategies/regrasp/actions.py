@@ -10,7 +10,6 @@ orientation and checks.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
 
 from .model import HandModel, Side
 from .orientation import Orientation
@@ -49,7 +48,9 @@ class Twist:
 
     gripper: Side
     axis: str
-    layer: int  #: slab along ``axis``: 0 on the - side, 2 on the + side (1, a slice, is never planned)
+    layer: (
+        int  #: slab along ``axis``: 0 on the - side, 2 on the + side (1, a slice, is never planned)
+    )
     quarter_turns: int
     face: str = ""
     source: int = -1
@@ -97,7 +98,7 @@ class Release:
     """Terminate: both hands open (the protocol's "robot terminates manipulation")."""
 
 
-Action = Union[Pick, Twist, Regrasp, Handover, Release]
+Action = Pick | Twist | Regrasp | Handover | Release
 
 
 @dataclass(frozen=True)
@@ -182,6 +183,8 @@ def _describe(a: Action, moves: tuple[str, ...]) -> str:
         roll = f", roll {a.roll:+d}" if a.roll else ""
         return f"regrasp   shift: the hands swap roles, rotator now {a.gripper}{roll}"
     if isinstance(a, Handover):
-        return (f"handover  {a.giver} turns the cube {_turns(a.quarter_turns)} about {a.axis}, "
-                f"{a.taker} takes it; rotator {a.rotator}")
+        return (
+            f"handover  {a.giver} turns the cube {_turns(a.quarter_turns)} about {a.axis}, "
+            f"{a.taker} takes it; rotator {a.rotator}"
+        )
     return "release   both hands open"

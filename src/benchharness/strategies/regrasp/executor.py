@@ -17,7 +17,17 @@ import numpy as np
 
 from ...cube import SOLVED, Move, apply
 from .actions import Handover, Pick, Plan, Regrasp, Release, Twist
-from .model import GIVER_ENDS, PICK_APPROACHES, Grip, HandModel, Side, handover_turns, other, side_direction, side_layer
+from .model import (
+    GIVER_ENDS,
+    PICK_APPROACHES,
+    Grip,
+    HandModel,
+    Side,
+    handover_turns,
+    other,
+    side_direction,
+    side_layer,
+)
 from .orientation import Orientation, direction_vector
 
 __all__ = ["Execution", "PlanError", "TwistCheck", "carry_turn", "execute", "twist_move"]
@@ -58,7 +68,9 @@ def carry_turn(approach_direction: str, side: Side) -> tuple[str | None, int]:
     if np.array_equal(a, s):
         return None, 0
     if int(a @ s) != 0:
-        raise ValueError(f"a gripper on the {side} cannot carry the face at {approach_direction} round to its side")
+        raise ValueError(
+            f"a gripper on the {side} cannot carry the face at {approach_direction} round to its side"
+        )
     w = np.cross(a, s)  # a quarter turn about a × s takes a onto s
     (i,) = np.flatnonzero(w)
     return "xyz"[i], int(w[i])
@@ -67,7 +79,9 @@ def carry_turn(approach_direction: str, side: Side) -> tuple[str | None, int]:
 def twist_move(orientation: Orientation, axis: str, layer: int, quarter_turns: int) -> Move:
     """The centre-named face move a twist makes: the +axis face turns clockwise for negative turns."""
     if layer not in (0, 2):
-        raise ValueError(f"layer {layer}: two grippers can only turn an outer slab against the other two")
+        raise ValueError(
+            f"layer {layer}: two grippers can only turn an outer slab against the other two"
+        )
     face = orientation.face_along(("+" if layer == 2 else "-") + axis)
     cw = (-quarter_turns) % 4 if layer == 2 else quarter_turns % 4
     if cw == 0:
@@ -75,7 +89,9 @@ def twist_move(orientation: Orientation, axis: str, layer: int, quarter_turns: i
     return Move(face, cw)
 
 
-def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | None = None) -> Execution:
+def execute(
+    plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | None = None
+) -> Execution:
     """Run ``plan`` from ``initial_state`` (centre frame); raises :class:`PlanError` on any broken rule."""
     model = model or plan.model
     state = np.asarray(initial_state).copy()
@@ -88,7 +104,9 @@ def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | N
 
     def set_roles(k: int, rotator: Side, roll: int) -> None:
         if not model.roll_ok(roll):
-            raise fail(k, f"wrist roll {roll:+d} quarter turns is outside ±{model.wrist_roll_limit}")
+            raise fail(
+                k, f"wrist roll {roll:+d} quarter turns is outside ±{model.wrist_roll_limit}"
+            )
         grips[rotator] = Grip(1, roll)
         grips[other(rotator)] = Grip(2, 0)
 
@@ -103,10 +121,16 @@ def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | N
             where = PICK_APPROACHES[a.approach]
             where = side_direction(a.gripper) if where == "own" else where
             if plan.initial.face_along(where) != a.face:
-                raise fail(k, f"the face at {where} on the table is {plan.initial.face_along(where)}, not {a.face}")
+                raise fail(
+                    k,
+                    f"the face at {where} on the table is {plan.initial.face_along(where)}, not {a.face}",
+                )
             axis, q = carry_turn(where, a.gripper)
             if (axis, q) != (a.turn_axis, a.turn_quarters):
-                raise fail(k, f"carrying {a.face} to the {a.gripper} side is a turn {axis} {q:+d}, not {a.turn_axis} {a.turn_quarters:+d}")
+                raise fail(
+                    k,
+                    f"carrying {a.face} to the {a.gripper} side is a turn {axis} {q:+d}, not {a.turn_axis} {a.turn_quarters:+d}",
+                )
             orient = plan.initial if axis is None else plan.initial.rotated(axis, q)
             set_roles(k, a.rotator, a.roll)
         elif isinstance(a, Twist):
@@ -116,16 +140,27 @@ def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | N
             if g is None or h is None:
                 raise fail(k, "both hands must hold the cube")
             if a.layer != side_layer(a.gripper):
-                raise fail(k, f"the {a.gripper} gripper can only turn slab {side_layer(a.gripper)}, not {a.layer}")
+                raise fail(
+                    k,
+                    f"the {a.gripper} gripper can only turn slab {side_layer(a.gripper)}, not {a.layer}",
+                )
             rot_slabs, hold_slabs = g.slabs(a.gripper), h.slabs(other(a.gripper))
             if rot_slabs != {a.layer}:
-                raise fail(k, f"the rotator touches slabs {sorted(rot_slabs)}, not just slab {a.layer}")
+                raise fail(
+                    k, f"the rotator touches slabs {sorted(rot_slabs)}, not just slab {a.layer}"
+                )
             if hold_slabs != {0, 1, 2} - {a.layer}:
-                raise fail(k, f"the holder touches slabs {sorted(hold_slabs)}: "
-                              + ("under-constrained" if len(hold_slabs) < 2 else "over-constrained"))
+                raise fail(
+                    k,
+                    f"the holder touches slabs {sorted(hold_slabs)}: "
+                    + ("under-constrained" if len(hold_slabs) < 2 else "over-constrained"),
+                )
             new_roll = model.after_twist(g.roll, a.quarter_turns)
             if not model.roll_ok(new_roll):
-                raise fail(k, f"the wrist would roll to {new_roll:+d} quarter turns, beyond ±{model.wrist_roll_limit}")
+                raise fail(
+                    k,
+                    f"the wrist would roll to {new_roll:+d} quarter turns, beyond ±{model.wrist_roll_limit}",
+                )
             try:
                 move = twist_move(orient, a.axis, a.layer, a.quarter_turns)
             except ValueError as e:
@@ -135,12 +170,16 @@ def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | N
             state = apply(state, [move])
             grips[a.gripper] = Grip(1, new_roll)
             out.moves.append(str(move))
-            out.twists.append(TwistCheck(k, str(move), a.axis, a.layer, rot_slabs, hold_slabs, "y", "y"))
+            out.twists.append(
+                TwistCheck(k, str(move), a.axis, a.layer, rot_slabs, hold_slabs, "y", "y")
+            )
         elif isinstance(a, Regrasp):
             rot = next(s for s, gr in grips.items() if gr is not None and gr.depth == 1)
             if a.kind == "shift":
                 if a.gripper != other(rot):
-                    raise fail(k, f"a shift makes the holder ({other(rot)}) the rotator, not {a.gripper}")
+                    raise fail(
+                        k, f"a shift makes the holder ({other(rot)}) the rotator, not {a.gripper}"
+                    )
             elif a.kind == "unwind":
                 if a.gripper != rot:
                     raise fail(k, f"only the rotator ({rot}) unwinds")
@@ -152,9 +191,15 @@ def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | N
             if a.giver != holder or a.taker != other(holder):
                 raise fail(k, f"the holder ({holder}) gives, the other hand takes")
             if a.axis not in ("x", "z") or a.quarter_turns not in (1, -1):
-                raise fail(k, f"a hand-over turns the cube a quarter turn about x or z, not {a.quarter_turns:+d} about {a.axis}")
+                raise fail(
+                    k,
+                    f"a hand-over turns the cube a quarter turn about x or z, not {a.quarter_turns:+d} about {a.axis}",
+                )
             if (a.axis, a.quarter_turns) not in handover_turns(a.giver):
-                raise fail(k, f"turning {a.quarter_turns:+d} about {a.axis} would leave the {a.giver} hand outside {GIVER_ENDS}")
+                raise fail(
+                    k,
+                    f"turning {a.quarter_turns:+d} about {a.axis} would leave the {a.giver} hand outside {GIVER_ENDS}",
+                )
             orient = orient.rotated(a.axis, a.quarter_turns)
             set_roles(k, a.rotator, a.roll)
         elif isinstance(a, Release):
@@ -169,4 +214,3 @@ def execute(plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | N
     out.state = state
     out.orientation = orient if orient is not None else plan.initial
     return out
-

@@ -21,7 +21,7 @@ The model, in short (docs/planner.md has the reasoning):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache
 from typing import Literal
 
 from .orientation import direction_name, direction_vector, quarter_rotation
@@ -54,8 +54,8 @@ PICK_APPROACHES: dict[str, str] = {"side": "own", "top": "+z", "front": "-x"}
 GIVER_ENDS: tuple[str, ...] = ("-x", "+z")
 
 
-@lru_cache(maxsize=None)
-def handover_turns(giver: "Side") -> tuple[tuple[str, int], ...]:
+@cache
+def handover_turns(giver: Side) -> tuple[tuple[str, int], ...]:
     """The quarter turns (workspace axis, ±1) a giver on its side can give the cube: x or z, ending in :data:`GIVER_ENDS`.
 
     Each giver has two, and between them they bring every face off the work
@@ -65,7 +65,10 @@ def handover_turns(giver: "Side") -> tuple[tuple[str, int], ...]:
     out = []
     for axis in ("z", "x"):
         for q in (1, -1):
-            if direction_name(quarter_rotation(axis, q) @ direction_vector(side_direction(giver))) in GIVER_ENDS:
+            if (
+                direction_name(quarter_rotation(axis, q) @ direction_vector(side_direction(giver)))
+                in GIVER_ENDS
+            ):
                 out.append((axis, q))
     return tuple(out)
 
@@ -93,7 +96,9 @@ class Grip:
 
     def slabs(self, side: Side) -> frozenset[int]:
         """Slab indices along the work axis this grip touches (0 on the -y side, 2 on +y)."""
-        return frozenset(range(3 - self.depth, 3)) if side == "left" else frozenset(range(self.depth))
+        return (
+            frozenset(range(3 - self.depth, 3)) if side == "left" else frozenset(range(self.depth))
+        )
 
 
 @dataclass(frozen=True)
@@ -135,7 +140,9 @@ class HandModel:
             raise ValueError("a wrist that cannot roll a quarter turn cannot twist the cube")
         bad = [a for a in self.pick_approaches if a not in PICK_APPROACHES]
         if bad or not self.pick_approaches:
-            raise ValueError(f"pick approaches must be among {sorted(PICK_APPROACHES)}, got {self.pick_approaches!r}")
+            raise ValueError(
+                f"pick approaches must be among {sorted(PICK_APPROACHES)}, got {self.pick_approaches!r}"
+            )
 
     @property
     def rolls(self) -> tuple[int, ...]:
@@ -152,12 +159,12 @@ class HandModel:
         return 0 if self.wrist_roll_limit is None else roll + quarter_turns
 
     @classmethod
-    def pr2(cls) -> "HandModel":
+    def pr2(cls) -> HandModel:
         """PR2: parallel grippers, continuous wrist roll (``{l,r}_wrist_roll_joint``)."""
         return cls(name="pr2")
 
     @classmethod
-    def herb(cls) -> "HandModel":
+    def herb(cls) -> HandModel:
         """HERB: BarrettHands on WAM arms; joint 7 ranges ±172°, so ±1 quarter turn from neutral.
 
         Every re-clamp is a push-grasp (Yang et al., Sec. IV-D): the hand

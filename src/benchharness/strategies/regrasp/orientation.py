@@ -18,7 +18,7 @@ hundreds of regrasps).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import numpy as np
 
@@ -29,7 +29,9 @@ from ...cube.facelets import FACE_NORMALS
 #: plugin imports this package just to list strategies. A test pins the two to each other.
 BODY_FROM_CORE = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.int64)
 #: Outward normal of each face in the body frame.
-FACE_BODY_AXES: dict[str, np.ndarray] = {f: BODY_FROM_CORE @ np.array(n, dtype=np.int64) for f, n in FACE_NORMALS.items()}
+FACE_BODY_AXES: dict[str, np.ndarray] = {
+    f: BODY_FROM_CORE @ np.array(n, dtype=np.int64) for f, n in FACE_NORMALS.items()
+}
 
 __all__ = [
     "AXIS_VECTORS",
@@ -81,14 +83,18 @@ class Orientation:
     matrix: tuple[int, ...]
 
     @classmethod
-    def from_array(cls, m: np.ndarray) -> "Orientation":
+    def from_array(cls, m: np.ndarray) -> Orientation:
         m = np.asarray(m, dtype=np.int64)
-        if m.shape != (3, 3) or round(float(np.linalg.det(m))) != 1 or not np.array_equal(m.T @ m, np.eye(3, dtype=np.int64)):
+        if (
+            m.shape != (3, 3)
+            or round(float(np.linalg.det(m))) != 1
+            or not np.array_equal(m.T @ m, np.eye(3, dtype=np.int64))
+        ):
             raise ValueError(f"not one of the 24 cube rotations: {m.tolist()}")
         return cls(tuple(int(v) for v in m.ravel()))
 
     @classmethod
-    def from_faces(cls, up: str, front: str) -> "Orientation":
+    def from_faces(cls, up: str, front: str) -> Orientation:
         """The orientation with face ``up`` along +z and face ``front`` towards the robot (-x)."""
         b_up, b_front = FACE_BODY_AXES[up], FACE_BODY_AXES[front]
         if int(b_up @ b_front) != 0:
@@ -110,7 +116,7 @@ class Orientation:
         """The face whose outward normal points along the workspace ``direction`` (``"+y"``, ``"-x"``, …)."""
         return _faces_along(self)[direction]
 
-    def rotated(self, axis: str, quarter_turns: int) -> "Orientation":
+    def rotated(self, axis: str, quarter_turns: int) -> Orientation:
         """The orientation after turning the whole cube about a workspace axis."""
         return Orientation.from_array(quarter_rotation(axis, quarter_turns) @ self.array)
 
@@ -122,7 +128,7 @@ class Orientation:
         return self.describe()
 
 
-@lru_cache(maxsize=None)
+@cache
 def _faces_along(o: Orientation) -> dict[str, str]:
     m = o.array
     return {direction_name(m @ n): f for f, n in FACE_BODY_AXES.items()}

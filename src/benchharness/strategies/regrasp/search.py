@@ -19,14 +19,23 @@ same input always gives the same plan.
 from __future__ import annotations
 
 import heapq
+from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Iterable
 
 from ...cube import Move
 from .actions import Action, Handover, Pick, Plan, Regrasp, Release, Twist
 from .executor import carry_turn
-from .model import GRIPPERS, PICK_APPROACHES, HandModel, Side, handover_turns, other, side_direction, side_layer
+from .model import (
+    GRIPPERS,
+    PICK_APPROACHES,
+    HandModel,
+    Side,
+    handover_turns,
+    other,
+    side_direction,
+    side_layer,
+)
 from .orientation import INITIAL_ORIENTATION, Orientation, all_orientations
 from .translate import FaceTwist, MoveTwists, logical_twists
 
@@ -42,7 +51,9 @@ class NoPlanError(RuntimeError):
 
 
 @lru_cache(maxsize=1)
-def _tables() -> tuple[dict[Orientation, int], list[dict[str, str]], list[dict[tuple[str, int], int]]]:
+def _tables() -> tuple[
+    dict[Orientation, int], list[dict[str, str]], list[dict[tuple[str, int], int]]
+]:
     """Orientation index, the faces on the work axis, and every hand-over turn, per orientation."""
     orients = all_orientations()
     index = {o: i for i, o in enumerate(orients)}
@@ -56,11 +67,13 @@ class _Program:
     """The twists to make, as positions; alternatives (slice orders) branch at move boundaries."""
 
     twists: tuple[FaceTwist, ...]  #: twist at each position
-    successors: tuple[tuple[int, ...], ...]  #: positions after twisting at each position (_END = done)
+    successors: tuple[
+        tuple[int, ...], ...
+    ]  #: positions after twisting at each position (_END = done)
     starts: tuple[int, ...]
 
     @classmethod
-    def build(cls, moves: tuple[MoveTwists, ...]) -> "_Program":
+    def build(cls, moves: tuple[MoveTwists, ...]) -> _Program:
         groups = [m.alternatives for m in moves if any(m.alternatives)]
         twists: list[FaceTwist] = []
         firsts: list[list[int]] = []  # per group: first position of each alternative
@@ -73,7 +86,7 @@ class _Program:
                 twists.extend(alt)
                 lasts[-1].append(len(twists) - 1)
         succ: list[tuple[int, ...]] = [()] * len(twists)
-        for g, alts in enumerate(groups):
+        for g in range(len(groups)):
             nxt = tuple(firsts[g + 1]) if g + 1 < len(groups) else (_END,)
             for first, last in zip(firsts[g], lasts[g]):
                 for p in range(first, last):
@@ -102,7 +115,9 @@ def _lower_bounds(prog: _Program, model: HandModel) -> list[int]:
     for p in range(len(prog.twists) - 1, -1, -1):
         tw = prog.twists[p]
         own = c.twist_quarter * (2 if tw.turns == 2 else 1)
-        h[p] = own + min(0 if s == _END else pair(tw, prog.twists[s]) + h[s] for s in prog.successors[p])
+        h[p] = own + min(
+            0 if s == _END else pair(tw, prog.twists[s]) + h[s] for s in prog.successors[p]
+        )
     return h
 
 
@@ -187,12 +202,22 @@ def plan_sequence(
                         push((nxt, o, s, r2), g_cost + costs.twist_quarter * abs(q), node, act)
         # shift: the holder becomes the rotator
         for r2 in rolls:
-            push((pos, o, 1 - s, r2), g_cost + costs.shift, node, (Regrasp, ("shift", _SIDES[1 - s], r2)))
+            push(
+                (pos, o, 1 - s, r2),
+                g_cost + costs.shift,
+                node,
+                (Regrasp, ("shift", _SIDES[1 - s], r2)),
+            )
         # unwind
         if model.wrist_roll_limit is not None:
             for r2 in rolls:
                 if r2 != r:
-                    push((pos, o, s, r2), g_cost + costs.unwind, node, (Regrasp, ("unwind", side, r2)))
+                    push(
+                        (pos, o, s, r2),
+                        g_cost + costs.unwind,
+                        node,
+                        (Regrasp, ("unwind", side, r2)),
+                    )
         # hand-over: the holder gives, turning the cube a quarter turn about x or z (model.handover_turns)
         for t in handover_turns(other(side)):
             o2 = turns[o][t]
@@ -258,7 +283,11 @@ def naive_plan(
                         giver = other(rotator)
                         o, rotator = o2, hit[0]
                         q = _quarter_choices(tw.turns, side_layer(rotator))[0]
-                        actions.append(Handover(giver, other(giver), t[0], t[1], rotator, _start_roll(q, model)))
+                        actions.append(
+                            Handover(
+                                giver, other(giver), t[0], t[1], rotator, _start_roll(q, model)
+                            )
+                        )
                         cost += c.handover
                         break
             q = _quarter_choices(tw.turns, side_layer(rotator))[0]

@@ -25,8 +25,8 @@ tables of its own beyond the three slice identities.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 from ...cube import SOLVED, Move, apply, parse_move, parse_sequence
 from ...cube.facelets import CENTRE_INDICES, FACE_INDEX, FACES
@@ -77,10 +77,16 @@ def _centre_at(frame_state, spatial_face: str) -> str:
 
 def logical_twists(moves: str | Iterable[Move | str]) -> tuple[MoveTwists, ...]:
     """Rewrite a move sequence (any core notation) as centre-named face twists."""
-    seq = parse_sequence(moves) if isinstance(moves, str) else tuple(
-        m if isinstance(m, Move) else parse_move(m, i) for i, m in enumerate(moves, start=1)
+    seq = (
+        parse_sequence(moves)
+        if isinstance(moves, str)
+        else tuple(
+            m if isinstance(m, Move) else parse_move(m, i) for i, m in enumerate(moves, start=1)
+        )
     )
-    frame = SOLVED  # the solved cube carried through every frame change: its centres say who is where
+    frame = (
+        SOLVED  # the solved cube carried through every frame change: its centres say who is where
+    )
     out: list[MoveTwists] = []
     for i, m in enumerate(seq):
         if m.kind in "URFDLB":
