@@ -40,8 +40,9 @@ def installed(tmp_path_factory):
         check=True,
         cwd=build,
     )
-    env = dict(os.environ, PYTHONPATH=str(target))
-    return env
+    # the target goes first; whatever PYTHONPATH already says (a source checkout under test) stays
+    path = os.pathsep.join(p for p in (str(target), os.environ.get("PYTHONPATH", "")) if p)
+    return dict(os.environ, PYTHONPATH=path)
 
 
 def run(env, *args):
@@ -56,6 +57,11 @@ def test_items_appear_with_the_example_distribution(installed):
     assert mine[("robot", "example-gantry-gripper")] == "benchharness-example-plugin"
     assert mine[("task", "Example-Rubiks-2-3")] == "benchharness-example-plugin"
     assert data["errors"] == []
+    robot = next(i for i in data["items"] if i["name"] == "example-gantry-gripper")
+    # read off the plugin's RobotConfig: gantry_x/y/z and two fingers, the URDF's movable joints
+    assert robot["meta"]["dof"] == 5
+    assert robot["meta"]["groups"] == ["gantry", "gripper"]
+    assert robot["meta"]["urdf"].endswith("benchharness_example/gantry_gripper.urdf")
 
 
 def test_not_visible_without_installing():

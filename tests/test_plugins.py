@@ -195,3 +195,282 @@ def test_inhand_task_sets_load_the_published_tasks():
     assert len(set(level1.object[level1.level == 1])) == 10
     dmg = m.create("task", "inhand-level3-dmg")
     assert sorted(dmg.object) == ["cracker box", "gelatin box", "potted meat can", "spatula"]
+
+
+# -- hooks go through pluggy's relay; hook names are checked ------------------------------------
+
+TYPO = """
+from benchharness.plugin import Registration, hookimpl
+
+@hookimpl
+def benchharness_robot():  # the hook is benchharness_robots
+    return [Registration("typo-arm", lambda **kw: "arm")]
+
+@hookimpl
+def benchharness_tasks():
+    return [Registration("typo-task", lambda **kw: "task")]
+"""
+
+UNMARKED = """
+from benchharness.plugin import Registration
+
+def benchharness_robots():  # no @hookimpl: pluggy never calls it
+    return [Registration("unmarked-arm", lambda **kw: "arm")]
+"""
+
+
+def test_misspelled_hook_is_a_load_error_naming_entry_point_and_distribution(site):
+    make_distribution(
+        site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD}
+    )
+    make_distribution(
+        site, "thirdparty-typo", {"typo": "thirdparty_typo"}, {"thirdparty_typo": TYPO}
+    )
+    m = PluginManager()
+    m.load_entry_points()
+    assert m.get("robot", "thirdparty-arm")  # every other plugin still loads
+    (err,) = [e for e in m.errors if e.distribution == "thirdparty-typo"]
+    assert err.entry_point == "typo = thirdparty_typo"
+    assert "unknown hook 'benchharness_robot'" in err.reason
+    assert "benchharness_robots" in err.reason  # the hooks that exist are listed
+    # refused whole: its correctly spelled hook would hide the typo
+    assert "typo-task" not in m.names("task") and "typo-arm" not in m.names("robot")
+    assert "thirdparty_typo" not in {
+        m.pluggy_manager.get_name(p) for p in m.pluggy_manager.get_plugins()
+    }
+
+
+def test_unmarked_hook_is_a_load_error_not_called(site):
+    make_distribution(
+        site,
+        "thirdparty-unmarked",
+        {"unm": "thirdparty_unmarked"},
+        {"thirdparty_unmarked": UNMARKED},
+    )
+    m = PluginManager()
+    m.load_entry_points()
+    assert "unmarked-arm" not in m.names("robot")
+    (err,) = [e for e in m.errors if e.distribution == "thirdparty-unmarked"]
+    assert "benchharness_robots is not marked with @hookimpl" in err.reason
+    assert "unm = thirdparty_unmarked" in str(err) and "thirdparty-unmarked" in str(err)
+
+
+def test_hooks_are_called_through_the_relay(site):
+    """Items come from pluggy's hook relay: what ``pm.hook`` returns is what is registered."""
+    make_distribution(
+        site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD}
+    )
+    m = PluginManager()
+    m.load_entry_points()
+    relay = m.pluggy_manager.hook
+    from_relay = {r.name for regs in relay.benchharness_robots() for r in regs}
+    assert from_relay == set(m.names("robot"))
+    assert {"pr2", "thirdparty-arm"} <= from_relay
+    # each implementation pluggy knows is named by its entry point (provenance)
+    impl_names = {i.plugin_name for i in relay.benchharness_robots.get_hookimpls()}
+    assert "good = thirdparty_good" in impl_names
+    assert "robots = benchharness_builtins.robots" in impl_names
+
+
+def test_every_builtin_module_is_a_clean_pluggy_plugin():
+    """The built-ins are registered in one style: entry point, @hookimpl hooks, no errors."""
+    m = get_manager(reload=True)
+    assert not m.errors, m.errors
+    names = {m.pluggy_manager.get_name(p) for p in m.pluggy_manager.get_plugins()}
+    builtin = {n for n in names if "benchharness_builtins" in n}
+    assert builtin == {
+        f"{ep} = benchharness_builtins.{ep}"
+        for ep in ("backends", "inhand_tasks", "robots", "rubiks_tasks", "sensors", "strategies")
+    }
+    assert {it.distribution for it in m.items()} == {"benchharness"}
+
+
+# -- the block list ----------------------------------------------------------------------------
+
+EXPLODES = """
+raise RuntimeError("this plugin must not even be imported")
+"""
+
+
+def test_disabled_plugin_is_not_imported_and_is_reported(site, monkeypatch):
+    make_distribution(
+        site, "thirdparty-good", {"good": "thirdparty_good"}, {"thirdparty_good": GOOD}
+    )
+    make_distribution(
+        site, "thirdparty-bomb", {"bomb": "thirdparty_bomb"}, {"thirdparty_bomb": EXPLODES}
+    )
+    monkeypatch.setenv("BENCHHARNESS_DISABLED_PLUGINS", " bomb , good,nosuch")
+    m = PluginManager()
+    m.load_entry_points()
+    assert m.errors == []  # the bomb was never imported
+    assert "thirdparty_bomb" not in sys.modules
+    assert {(d.entry_point, d.distribution) for d in m.disabled} == {
+        ("bomb = thirdparty_bomb", "thirdparty-bomb"),
+        ("good = thirdparty_good", "thirdparty-good"),
+    }
+    assert m.disabled_unmatched == ["nosuch"]
+    assert "pr2" in m.names("robot")  # the built-ins still load
+    with pytest.raises(PluginNotFoundError) as info:
+        m.get("robot", "thirdparty-arm")
+    assert "disabled by BENCHHARNESS_DISABLED_PLUGINS" in str(info.value)
+    assert "good = thirdparty_good" in str(info.value)
+
+    monkeypatch.delenv("BENCHHARNESS_DISABLED_PLUGINS")
+    m = PluginManager()
+    m.load_entry_points()
+    assert m.get("robot", "thirdparty-arm").distribution == "thirdparty-good"
+    assert any(e.distribution == "thirdparty-bomb" for e in m.errors)
+
+
+def test_plugins_command_lists_disabled(monkeypatch):
+    import json
+
+    from click.testing import CliRunner
+
+    from benchharness.cli.plugins import plugins_cmd
+
+    monkeypatch.setenv("BENCHHARNESS_DISABLED_PLUGINS", "sensors,typo_name")
+    get_manager(reload=True)
+    try:
+        out = CliRunner().invoke(plugins_cmd, ["--json"], catch_exceptions=False)
+        data = json.loads(out.output)
+        assert data["disabled"] == [
+            {
+                "entry_point": "sensors = benchharness_builtins.sensors",
+                "distribution": "benchharness",
+            }
+        ]
+        assert data["disabled_unmatched"] == ["typo_name"]
+        assert not [i for i in data["items"] if i["kind"] == "sensor"]
+        text = CliRunner().invoke(plugins_cmd, [], catch_exceptions=False).output
+        assert "disabled:" in text and "'sensors = benchharness_builtins.sensors'" in text
+        assert "'typo_name', which is no entry point" in text
+    finally:
+        monkeypatch.delenv("BENCHHARNESS_DISABLED_PLUGINS")
+        get_manager(reload=True)
+
+
+# -- robot metadata comes from the robot's config -------------------------------------------------
+
+
+def _movable_joints(urdf: Path) -> set[str]:
+    import xml.etree.ElementTree as ET
+
+    return {
+        j.get("name", "")
+        for j in ET.parse(urdf).getroot().iter("joint")
+        if j.get("type") != "fixed"
+    }
+
+
+@pytest.mark.parametrize(
+    ("name", "module", "config"),
+    [
+        ("pr2", "pr2", "pr2_config"),
+        ("herb", "herb", "herb_config"),
+        ("allegro", "allegro", "allegro_config"),
+        ("pr2-gripper", "pr2_gripper", "pr2_gripper_config"),
+    ],
+)
+def test_robot_meta_matches_config_and_urdf(name, module, config):
+    """DOF = the URDF's movable joints (an independent count), groups = the config's groups."""
+    import importlib
+
+    from benchharness.paths import data_root
+
+    cfg = getattr(importlib.import_module(f"benchharness.robots.{module}"), config)()
+    meta = get_manager(reload=True).get("robot", name).meta
+    urdf = data_root() / meta["urdf"]
+    assert urdf.resolve() == Path(cfg.urdf).resolve()
+    assert meta["dof"] == len(_movable_joints(urdf))
+    assert meta["groups"] == list(cfg.groups())
+    assert {j for g in cfg.groups().values() for j in g} == _movable_joints(urdf)
+
+
+def test_listing_robots_reads_configs_without_torch():
+    import subprocess
+
+    code = (
+        "import sys, json\n"
+        "from benchharness.plugin import get_manager\n"
+        "print(json.dumps([it.meta['dof'] for it in get_manager().items('robot')]))\n"
+        "heavy = {m.split('.')[0] for m in sys.modules} & {'torch', 'pybullet', 'sapien'}\n"
+        "print(','.join(sorted(heavy)))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    assert out[0] == "[19, 30, 16, 8]"
+    assert out[1:] == [""], f"reading robot metadata imported {out[1:]}"
+
+
+def test_lazy_meta_is_read_once():
+    calls = []
+
+    def meta():
+        calls.append(1)
+        return {"dof": 3}
+
+    class P:
+        @hookimpl
+        def benchharness_robots(self):
+            return [Registration("lazy-arm", lambda: None, "lazy", meta)]
+
+    m = PluginManager()
+    m.register_module(P(), entry_point="p = p", distribution="p-dist")
+    assert calls == []  # registering does not build the config
+    item = m.get("robot", "lazy-arm")
+    assert item.meta == {"dof": 3} and item.describe()["meta"] == {"dof": 3}
+    assert calls == [1]
+
+
+# -- strategies declare the robots they drive; a mismatch is refused before any trial -----------
+
+
+def test_every_builtin_strategy_declares_registered_robots():
+    from benchharness.runner.contract import declared_robots
+
+    m = get_manager(reload=True)
+    robots = set(m.names("robot"))
+    declared = {it.name: declared_robots(it.meta) for it in m.items("strategy")}
+    assert all(declared.values()), declared
+    assert all(set(r) <= robots for r in declared.values() if r), declared
+    assert declared["sensor-aided"] == ("pr2",)
+    assert declared["relaxed-rigidity"] == ("allegro",)
+    assert declared["push-grasp"] == ("herb",)
+    assert declared["dmg"] == declared["pivoting"] == ("pr2-gripper",)
+
+
+@pytest.mark.parametrize(
+    ("task", "robot", "strategy", "drives"),
+    [
+        ("Rubiks-1-5", "allegro", "sensor-aided", "pr2"),
+        ("Rubiks-1-5", "pr2", "relaxed-rigidity", "allegro"),
+        ("inhand-level1", "pr2", "relaxed-rigidity", "allegro"),
+    ],
+)
+def test_run_refuses_a_robot_the_strategy_does_not_drive(tmp_path, task, robot, strategy, drives):
+    from click.testing import CliRunner
+
+    from benchharness.cli.run import run
+
+    store = tmp_path / "results.sqlite"
+    args = ["--task", task, "--robot", robot, "--strategy", strategy, "--store", str(store)]
+    r = CliRunner().invoke(run, [*args, "--workers", "0", "--no-progress"])
+    assert r.exit_code == 2, r.output
+    lines = r.output.strip().splitlines()
+    assert lines == [
+        f"error: --robot {robot!r}: strategy {strategy!r} drives only these robots: {drives}"
+    ]
+    assert not store.exists()  # refused before the store was opened, so nothing was stored
+
+
+def test_check_drives_accepts_declared_and_undeclared():
+    from benchharness.runner.contract import check_drives
+
+    check_drives("s", {"robots": ["pr2", "herb"]}, "herb")
+    check_drives("s", {}, "anything")  # no declaration: any robot
+    with pytest.raises(ValueError, match="drives only these robots: pr2, herb$"):
+        check_drives("s", {"robots": ["pr2", "herb"]}, "allegro")
+    with pytest.raises(TypeError):
+        check_drives("s", {"robots": "pr2"}, "pr2")  # a string is not a list of names

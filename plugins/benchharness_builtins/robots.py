@@ -1,79 +1,74 @@
-"""Built-in robots: PR2, HERB and the Allegro hand, registered like any third-party robot.
+"""Built-in robots: PR2, HERB, the Allegro hand and the stand-alone PR2 gripper.
 
-The factories import torch and pytorch-kinematics only when a robot is
-created, so listing plugins stays light.
+Each registration names the module holding the robot's config function and
+factory; both are imported only when used. The listed facts (DOF, joint
+groups, URDF) are read off the config by
+:func:`benchharness.robots.config.robot_meta` the first time they are asked
+for, so they cannot drift from the robot, and listing plugins imports no
+robot code.
 """
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Callable, Mapping
+from typing import Any
+
 from benchharness.plugin import Registration, hookimpl
 
+#: name -> (module under benchharness.robots, config function, factory, summary)
+ROBOTS = {
+    "pr2": (
+        "pr2",
+        "pr2_config",
+        "make_pr2",
+        "Willow Garage PR2: torso, two 7-DOF arms, parallel grippers",
+    ),
+    "herb": (
+        "herb",
+        "herb_config",
+        "make_herb",
+        "CMU HERB: two Barrett WAM arms with BarrettHand BH8-280",
+    ),
+    "allegro": (
+        "allegro",
+        "allegro_config",
+        "make_allegro",
+        "Allegro hand v4 (right), 16 joints",
+    ),
+    "pr2-gripper": (
+        "pr2_gripper",
+        "pr2_gripper_config",
+        "make_pr2_gripper",
+        "PR2 parallel gripper on a 6-DOF stage (in-hand pivoting / DMG execution)",
+    ),
+}
 
-def _pr2(**kwargs):
-    from benchharness.robots.pr2 import make_pr2
 
-    return make_pr2(**kwargs)
-
-
-def _herb(**kwargs):
-    from benchharness.robots.herb import make_herb
-
-    return make_herb(**kwargs)
+def _attr(module: str, name: str) -> Any:
+    return getattr(importlib.import_module(f"benchharness.robots.{module}"), name)
 
 
-def _allegro(**kwargs):
-    from benchharness.robots.allegro import make_allegro
+def _factory(module: str, name: str) -> Callable[..., Any]:
+    def factory(**kwargs: Any) -> Any:
+        return _attr(module, name)(**kwargs)
 
-    return make_allegro(**kwargs)
+    factory.__doc__ = f"Plugin factory: benchharness.robots.{module}.{name}(**kwargs)."
+    return factory
 
 
-def _pr2_gripper(**kwargs):
-    from benchharness.robots.pr2_gripper import make_pr2_gripper
+def _meta(module: str, config: str) -> Callable[[], Mapping[str, Any]]:
+    def meta() -> Mapping[str, Any]:
+        from benchharness.robots.config import robot_meta
 
-    return make_pr2_gripper(**kwargs)
+        return robot_meta(_attr(module, config)())
+
+    return meta
 
 
 @hookimpl
-def benchharness_robots():
+def benchharness_robots() -> list[Registration]:
     return [
-        Registration(
-            "pr2",
-            _pr2,
-            "Willow Garage PR2: torso, two 7-DOF arms, parallel grippers",
-            meta={
-                "dof": 19,
-                "groups": ["left_arm", "right_arm", "left_gripper", "right_gripper", "torso"],
-                "urdf": "robots/pr2/pr2.urdf",
-            },
-        ),
-        Registration(
-            "herb",
-            _herb,
-            "CMU HERB: two Barrett WAM arms with BarrettHand BH8-280",
-            meta={
-                "dof": 30,
-                "groups": ["left_arm", "right_arm", "left_hand", "right_hand"],
-                "urdf": "robots/herb/herb.urdf",
-            },
-        ),
-        Registration(
-            "allegro",
-            _allegro,
-            "Allegro hand v4 (right), 16 joints",
-            meta={
-                "dof": 16,
-                "groups": ["index", "middle", "ring", "thumb", "hand"],
-                "urdf": "robots/allegro/allegro.urdf",
-            },
-        ),
-        Registration(
-            "pr2-gripper",
-            _pr2_gripper,
-            "PR2 parallel gripper on a 6-DOF stage (in-hand pivoting / DMG execution)",
-            meta={
-                "dof": 8,
-                "groups": ["stage", "gripper"],
-                "urdf": "robots/pr2_gripper/pr2_gripper.urdf",
-            },
-        ),
+        Registration(name, _factory(module, make), summary, _meta(module, config))
+        for name, (module, config, make, summary) in ROBOTS.items()
     ]

@@ -61,6 +61,13 @@ def make_gantry_gripper(**_: object):
     return Robot(gantry_gripper_config())
 
 
+def _robot_meta() -> dict[str, object]:
+    """DOF, groups and URDF as ``benchharness robots`` lists them, read off the config."""
+    from benchharness.robots.config import robot_meta
+
+    return robot_meta(gantry_gripper_config())
+
+
 @hookimpl
 def benchharness_robots() -> list[Registration]:
     return [
@@ -68,7 +75,7 @@ def benchharness_robots() -> list[Registration]:
             "example-gantry-gripper",
             make_gantry_gripper,
             "Example: parallel gripper on a 3-axis gantry (third-party plugin)",
-            meta={"dof": 5},
+            meta=_robot_meta,
         )
     ]
 

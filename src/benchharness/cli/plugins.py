@@ -1,12 +1,13 @@
-"""``benchharness plugins``: what is registered, by whom, and what failed to load."""
+"""``benchharness plugins``: what is registered, by whom, what failed to load, what is disabled."""
 
 from __future__ import annotations
 
 import click
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
-from ..plugin import KIND_HOOKS, get_manager
+from ..plugin import DISABLED_ENV, KIND_HOOKS, get_manager
 from .common import emit_json, json_option
 
 
@@ -23,7 +24,9 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
 
     Items come from the 'benchharness' entry-point group: built-ins and
     third-party distributions alike. Plugins that failed to load are listed
-    with the entry point, the distribution and the reason.
+    with the entry point, the distribution and the reason; entry points named
+    in BENCHHARNESS_DISABLED_PLUGINS (comma-separated) are not loaded and are
+    listed as disabled.
     """
     manager = get_manager()
     items = manager.items(kind)
@@ -39,16 +42,30 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
                     }
                     for e in manager.errors
                 ],
+                "disabled": [
+                    {"entry_point": d.entry_point, "distribution": d.distribution}
+                    for d in manager.disabled
+                ],
+                "disabled_unmatched": list(manager.disabled_unmatched),
             }
         )
         return
     console = Console()
     table = Table(title="benchharness plugins")
-    for col in ("kind", "name", "distribution", "summary"):
+    for col in ("kind", "name", "distribution", "entry point", "summary"):
         table.add_column(col)
-    # stable sort: by kind, then in registration order (tiers stay 1-5, 1-10, ...)
+    # stable sort: by kind, then in registration order (tiers stay 1-5, 1-10, ...); the
+    # entry point column shows the name BENCHHARNESS_DISABLED_PLUGINS takes
     for it in sorted(items, key=lambda i: list(KIND_HOOKS).index(i.kind)):
-        table.add_row(it.kind, it.name, it.distribution, it.summary)
+        table.add_row(
+            it.kind, it.name, it.distribution, escape(it.entry_point.split(" = ")[0]), it.summary
+        )
     console.print(table)
     for e in manager.errors:
-        console.print(f"[red]failed:[/red] {e}")
+        console.print(f"[red]failed:[/red] {escape(str(e))}")
+    for d in manager.disabled:
+        console.print(f"[yellow]disabled:[/yellow] {escape(str(d))}")
+    for name in manager.disabled_unmatched:
+        console.print(
+            f"[yellow]{DISABLED_ENV}[/yellow] names {escape(repr(name))}, which is no entry point"
+        )

@@ -167,7 +167,7 @@ def _spec(
 ):
     from ..plugin import PluginNotFoundError
     from ..runner.contract import TimeBudget
-    from ..runner.plugins import lookup
+    from ..runner.plugins import check_strategy_robot, lookup
     from ..runner.spec import RunSpec, parse_physics
     from ..runner.tasks import plan_task
 
@@ -183,6 +183,7 @@ def _spec(
     try:
         item = lookup("task", task, tuple(plugins))
         plan = plan_task(item.name, item.create(), seed, repeats)
+        check_strategy_robot(strategy, robot, tuple(plugins))
     except (PluginNotFoundError, TypeError, ValueError) as exc:
         fail(str(exc))
     if sim_budget is None:

@@ -1,36 +1,63 @@
 """Discovers plugins through entry points and keeps the registry of items.
 
-Loading is per entry point and fault-isolated: a plugin that fails to import,
-whose hook raises, or that registers a name already taken is recorded as a
-:class:`PluginLoadError` naming the entry point and its distribution, and
-every other plugin still loads. Lookups of a missing item say which group was
-searched, what exists, and which plugins failed, so "robot not found" is never
-a dead end.
+Every hook is called through pluggy's hook relay (``pm.hook.benchharness_*``),
+one entry point at a time (:meth:`pluggy.PluginManager.subset_hook_caller`
+leaves the others out), so that:
 
-Order is deterministic: the ``benchharness`` distribution's own entry points
-first (built-ins win name clashes), then the others sorted by distribution
-and entry-point name.
+* **fault isolation**: a plugin that fails to import, names a hook that does
+  not exist (``benchharness_robot``), leaves a hook unmarked (no
+  ``@hookimpl``: pluggy would never call it), whose hook raises, or that
+  registers a name already taken is recorded as a :class:`PluginLoadError`
+  naming the entry point and its distribution, and every other plugin still
+  loads;
+* **provenance**: each item knows the entry point and distribution that
+  provided it (``benchharness plugins`` lists them).
+
+A plugin with a hook-name error is refused whole: loading the hooks it spelled
+right would hide the one it did not.
+
+Entry points named in ``BENCHHARNESS_DISABLED_PLUGINS`` (comma-separated) are
+not imported at all, as tox's ``TOX_DISABLED_EXTERNAL_PLUGINS``: a broken or
+unwanted plugin is switched off without uninstalling it.
+
+Lookups of a missing item say which group was searched, what exists, which
+plugins failed and which were disabled, so "robot not found" is never a dead
+end. Order is deterministic: the ``benchharness`` distribution's own entry
+points first (built-ins win name clashes), then the others sorted by
+distribution and entry-point name.
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import threading
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
 from importlib import metadata
 from types import ModuleType
 from typing import Any
 
 import pluggy
 
-from .spec import ENTRY_POINT_GROUP, KIND_HOOKS, PROJECT, BenchharnessSpec, Registration
+from .spec import (
+    DISABLED_ENV,
+    ENTRY_POINT_GROUP,
+    HOOK_PREFIX,
+    KIND_HOOKS,
+    PROJECT,
+    BenchharnessSpec,
+    Registration,
+)
 
 __all__ = [
+    "DisabledPlugin",
     "Item",
     "PluginLoadError",
     "PluginNotFoundError",
     "PluginManager",
+    "disabled_names",
     "get_manager",
 ]
 
@@ -39,7 +66,11 @@ BUILTIN_DISTRIBUTION = "benchharness"
 
 @dataclass(frozen=True)
 class Item:
-    """A registered item and where it came from."""
+    """A registered item and where it came from.
+
+    ``meta`` is resolved on first use when the registration gave a callable
+    (a robot's DOF and groups come from its config, which only listing needs).
+    """
 
     kind: str
     name: str
@@ -47,12 +78,19 @@ class Item:
     summary: str
     distribution: str
     entry_point: str
-    meta: dict
+    meta_source: Mapping[str, Any] | Callable[[], Mapping[str, Any]] = field(
+        default_factory=dict, repr=False
+    )
+
+    @cached_property
+    def meta(self) -> dict[str, Any]:
+        src = self.meta_source
+        return dict(src() if callable(src) else src)
 
     def create(self, **kwargs: Any) -> Any:
         return self.factory(**kwargs)
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         return {
             "kind": self.kind,
             "name": self.name,
@@ -78,6 +116,20 @@ class PluginLoadError:
         )
 
 
+@dataclass(frozen=True)
+class DisabledPlugin:
+    """An entry point named in ``BENCHHARNESS_DISABLED_PLUGINS`` and therefore not loaded."""
+
+    entry_point: str
+    distribution: str
+
+    def __str__(self) -> str:
+        return (
+            f"entry point {self.entry_point!r} of distribution {self.distribution!r} "
+            f"(disabled by {DISABLED_ENV})"
+        )
+
+
 class PluginNotFoundError(LookupError):
     """No item of that kind and name is registered."""
 
@@ -88,7 +140,34 @@ def _entry_point_label(ep: metadata.EntryPoint) -> str:
 
 def _distribution_name(ep: metadata.EntryPoint) -> str:
     dist = getattr(ep, "dist", None)
-    return dist.metadata["Name"] if dist is not None else "(unknown distribution)"
+    return str(dist.metadata["Name"]) if dist is not None else "(unknown distribution)"
+
+
+def disabled_names(environ: Mapping[str, str] | None = None) -> frozenset[str]:
+    """Entry-point names listed in ``BENCHHARNESS_DISABLED_PLUGINS`` (comma-separated)."""
+    raw = (os.environ if environ is None else environ).get(DISABLED_ENV, "")
+    return frozenset(n.strip() for n in raw.split(",") if n.strip())
+
+
+def hook_name_problems(plugin: object, impls: Iterable[str]) -> list[str]:
+    """What is wrong with a plugin's ``benchharness_*`` attributes, one line each.
+
+    ``impls`` are the names pluggy registered as hook implementations (marked
+    with ``@hookimpl``). A prefixed name that is no hook (a typo; pluggy keeps
+    it as a pending hook that nothing calls) or a hook left unmarked (pluggy
+    skips it) would otherwise register nothing without a word.
+    """
+    marked = set(impls)
+    hooks = set(KIND_HOOKS.values())
+    problems = []
+    for attr in sorted(dir(plugin)):
+        if not attr.startswith(HOOK_PREFIX) or not callable(getattr(plugin, attr, None)):
+            continue
+        if attr not in hooks:
+            problems.append(f"unknown hook {attr!r}; the hooks are {', '.join(sorted(hooks))}")
+        elif attr not in marked:
+            problems.append(f"{attr} is not marked with @hookimpl, so it would never be called")
+    return problems
 
 
 class PluginManager:
@@ -99,9 +178,24 @@ class PluginManager:
         self._pm.add_hookspecs(BenchharnessSpec)
         self._items: dict[tuple[str, str], Item] = {}
         self.errors: list[PluginLoadError] = []
+        self.disabled: list[DisabledPlugin] = []
+        #: names in ``BENCHHARNESS_DISABLED_PLUGINS`` that match no entry point (a typo there)
+        self.disabled_unmatched: list[str] = []
+
+    @property
+    def pluggy_manager(self) -> pluggy.PluginManager:
+        """The underlying pluggy manager (every plugin registered, named by its entry point)."""
+        return self._pm
 
     # -- loading -----------------------------------------------------------
-    def load_entry_points(self, group: str = ENTRY_POINT_GROUP) -> None:
+    def load_entry_points(
+        self, group: str = ENTRY_POINT_GROUP, disabled: Iterable[str] | None = None
+    ) -> None:
+        """Load every entry point of ``group`` except those named in ``disabled``.
+
+        ``disabled`` defaults to :func:`disabled_names` (the environment).
+        """
+        blocked = disabled_names() if disabled is None else frozenset(disabled)
         eps = list(metadata.entry_points(group=group))
         eps.sort(
             key=lambda ep: (
@@ -117,6 +211,9 @@ class PluginManager:
                 continue
             seen.add((dist, ep.name))
             label = _entry_point_label(ep)
+            if ep.name in blocked:
+                self.disabled.append(DisabledPlugin(label, dist))
+                continue
             try:
                 module = ep.load()
             except Exception as exc:  # noqa: BLE001 - any import failure is the plugin's
@@ -125,6 +222,8 @@ class PluginManager:
                 )
                 continue
             self.register_module(module, entry_point=label, distribution=dist)
+        names = {ep.name for ep in eps}
+        self.disabled_unmatched = sorted(blocked - names)
 
     def register_module(
         self,
@@ -133,30 +232,46 @@ class PluginManager:
         entry_point: str | None = None,
         distribution: str = "(registered in process)",
     ) -> None:
-        """Register a plugin object directly (tests, notebooks, embedding)."""
-        label = entry_point or getattr(module, "__name__", repr(module))
+        """Register a plugin object (a module, or any object with hook methods) and take its items."""
+        label = str(entry_point or getattr(module, "__name__", repr(module)))
         try:
             self._pm.register(module, name=label)
-        except Exception as exc:  # noqa: BLE001 - pluggy validation errors
+        except Exception as exc:  # noqa: BLE001 - pluggy validation errors, a name taken twice
             self.errors.append(PluginLoadError(label, distribution, f"invalid plugin: {exc}"))
             return
+        impls = [
+            caller.name
+            for caller in self._pm.get_hookcallers(module) or []
+            if caller.name.startswith(HOOK_PREFIX)
+        ]
+        problems = hook_name_problems(module, impls)
+        if problems:
+            self._pm.unregister(module)
+            self.errors.append(
+                PluginLoadError(label, distribution, "not loaded: " + "; ".join(problems))
+            )
+            return
+        others = [p for p in self._pm.get_plugins() if p is not module]
         for kind, hook_name in KIND_HOOKS.items():
-            impl = getattr(module, hook_name, None)
-            if impl is None:
+            if hook_name not in impls:
                 continue
+            call = self._pm.subset_hook_caller(hook_name, remove_plugins=others)
             try:
-                regs = impl()
+                results = call()
             except Exception as exc:  # noqa: BLE001 - a plugin's hook raising is isolated
                 self.errors.append(
                     PluginLoadError(
-                        label, distribution, f"hook {hook_name} raised {type(exc).__name__}: {exc}"
+                        label,
+                        distribution,
+                        f"hook {hook_name} raised {type(exc).__name__}: {exc}",
                     )
                 )
                 continue
-            for reg in regs or []:
-                self._add(kind, reg, label, distribution)
+            for regs in results:
+                for reg in regs or []:
+                    self._add(kind, reg, label, distribution)
 
-    def _add(self, kind: str, reg: Registration, label: str, dist: str) -> None:
+    def _add(self, kind: str, reg: object, label: str, dist: str) -> None:
         if not isinstance(reg, Registration):
             self.errors.append(
                 PluginLoadError(
@@ -176,9 +291,7 @@ class PluginManager:
                 )
             )
             return
-        self._items[key] = Item(
-            kind, reg.name, reg.factory, reg.summary, dist, label, dict(reg.meta)
-        )
+        self._items[key] = Item(kind, reg.name, reg.factory, reg.summary, dist, label, reg.meta)
 
     # -- queries -----------------------------------------------------------
     def items(self, kind: str | None = None) -> list[Item]:
@@ -204,6 +317,9 @@ class PluginManager:
         if self.errors:
             msg.append("Plugins that failed to load:")
             msg.extend(f"  - {e}" for e in self.errors)
+        if self.disabled:
+            msg.append(f"Plugins disabled by {DISABLED_ENV}:")
+            msg.extend(f"  - {d}" for d in self.disabled)
         raise PluginNotFoundError("\n".join(msg))
 
     def create(self, kind: str, name: str, **kwargs: Any) -> Any:

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..geometry import Pose
 from ..paths import robots_dir
 from .config import ArmConfig, GripperConfig, RobotConfig
-from .robot import Robot
+
+if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+    from .robot import Robot
 
 __all__ = ["allegro_config", "make_allegro", "FINGERS"]
 
@@ -91,4 +94,6 @@ def make_allegro(
     base_pose: Pose | None = None,
     fixed_base: bool = True,
 ) -> Robot:
+    from .robot import Robot
+
     return Robot(allegro_config(urdf, joint_map, link_map, base_pose, fixed_base))

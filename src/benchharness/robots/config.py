@@ -22,7 +22,7 @@ import numpy as np
 
 from ..geometry import Pose
 
-__all__ = ["ArmConfig", "GripperConfig", "RobotConfig", "gains_from_effort"]
+__all__ = ["ArmConfig", "GripperConfig", "RobotConfig", "gains_from_effort", "robot_meta"]
 
 
 @dataclass(frozen=True)
@@ -178,3 +178,24 @@ def gains_from_effort(
     """
     e = np.asarray(efforts, dtype=float)
     return tuple((kp_per_effort * e).tolist()), tuple((kd_per_effort * e).tolist())
+
+
+def robot_meta(config: RobotConfig) -> dict[str, object]:
+    """What ``benchharness robots`` lists about a robot, read off its config.
+
+    ``dof``: the distinct joints of its groups (arms, grippers/hands, extra
+    groups), i.e. every joint the robot drives; ``groups``: the group names in
+    the config's order; ``urdf``: the description, relative to the data root
+    when it lies under it. Plugins register this instead of typing the
+    figures, so they cannot drift from the robot they describe.
+    """
+    from ..paths import data_root
+
+    groups = config.groups()
+    joints = {j for names in groups.values() for j in names}
+    urdf = Path(config.urdf)
+    try:
+        shown = urdf.resolve().relative_to(data_root().resolve()).as_posix()
+    except ValueError:
+        shown = str(urdf)
+    return {"dof": len(joints), "groups": list(groups), "urdf": shown}

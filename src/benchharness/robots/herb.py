@@ -4,12 +4,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..geometry import Pose
 from ..paths import robots_dir
 from .config import ArmConfig, GripperConfig, RobotConfig, gains_from_effort
 from .descriptions.herb import BH_COUPLING, BH_PROX, WAM_EFFORT
-from .robot import Robot
+
+if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+    from .robot import Robot
 
 __all__ = ["herb_config", "make_herb", "BARRETT_HAND_COUPLING"]
 
@@ -107,4 +110,6 @@ def make_herb(
     link_map: Mapping[str, str] | None = None,
     base_pose: Pose | None = None,
 ) -> Robot:
+    from .robot import Robot
+
     return Robot(herb_config(urdf, joint_map, link_map, base_pose))

@@ -4,12 +4,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..geometry import Pose
 from ..paths import robots_dir
 from .config import ArmConfig, GripperConfig, RobotConfig, gains_from_effort
 from .descriptions.pr2 import FINGER_TRAVEL
-from .robot import Robot
+
+if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+    from .robot import Robot
 
 __all__ = ["PR2_FULL_URDF_LINK_MAP", "PR2_FULL_URDF_JOINT_MAP", "pr2_config", "make_pr2"]
 
@@ -119,4 +122,6 @@ def make_pr2(
     base_pose: Pose | None = None,
 ) -> Robot:
     """Plugin factory: our PR2, or the PR2 parts on ``urdf`` with names mapped (see module maps)."""
+    from .robot import Robot
+
     return Robot(pr2_config(urdf, joint_map, link_map, base_pose))

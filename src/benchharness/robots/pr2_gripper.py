@@ -10,6 +10,7 @@ the six stage joint values (the wrist's axes meet at the tool centre point).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -19,7 +20,9 @@ from ..paths import robots_dir
 from .config import ArmConfig, GripperConfig, RobotConfig
 from .descriptions.pr2 import FINGER_TRAVEL
 from .descriptions.pr2_gripper import MOUNT_RPY, SIDE, STAGE_EFFORT, WRIST_EFFORT
-from .robot import Robot
+
+if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+    from .robot import Robot
 
 __all__ = ["STAGE_JOINTS", "pr2_gripper_config", "make_pr2_gripper", "stage_joints_for", "MOUNT"]
 
@@ -102,6 +105,8 @@ def make_pr2_gripper(
     base_pose: Pose | None = None, grip_force: float = 20.0, urdf: str | Path | None = None
 ) -> Robot:
     """Plugin factory for ``pr2-gripper``; ``urdf`` may point at another file with the same names."""
+    from .robot import Robot
+
     cfg = pr2_gripper_config(base_pose, grip_force)
     if urdf is not None:
         from dataclasses import replace

@@ -39,6 +39,8 @@ __all__ = [
     "TrialItem",
     "TrialOutcome",
     "TrialTimeout",
+    "check_drives",
+    "declared_robots",
 ]
 
 
@@ -242,6 +244,30 @@ class Strategy(Protocol):
     returns a fresh instance (one per trial). Optional attribute
     ``benchmarks``: the benchmarks it can run (``("rubiks",)``,
     ``("inhand",)``); the runner refuses other tasks before starting.
+
+    The robots a strategy drives are declared in its registration, as
+    ``meta={"robots": ["pr2"]}`` (read by :func:`declared_robots`): the run
+    command refuses any other robot before a trial runs or a store is
+    opened, without building the strategy. No ``robots`` key: any robot.
     """
 
     def run_trial(self, ctx: TrialContext) -> TrialOutcome: ...
+
+
+def declared_robots(meta: Mapping[str, Any]) -> tuple[str, ...] | None:
+    """The robots a strategy's registration says it drives; ``None`` if it does not say."""
+    robots = meta.get("robots")
+    if robots is None:
+        return None
+    if isinstance(robots, str) or not all(isinstance(r, str) for r in robots):
+        raise TypeError(f"strategy meta 'robots' must be a list of robot names, not {robots!r}")
+    return tuple(robots)
+
+
+def check_drives(strategy: str, meta: Mapping[str, Any], robot: str) -> None:
+    """Raise a one-line :class:`ValueError` if strategy ``strategy`` does not drive ``robot``."""
+    robots = declared_robots(meta)
+    if robots is not None and robot not in robots:
+        raise ValueError(
+            f"--robot {robot!r}: strategy {strategy!r} drives only these robots: {', '.join(robots)}"
+        )

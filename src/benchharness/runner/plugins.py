@@ -15,8 +15,9 @@ from functools import lru_cache
 from typing import Any
 
 from ..plugin import Item, PluginManager, PluginNotFoundError, get_manager
+from .contract import check_drives
 
-__all__ = ["manager_for", "lookup", "create_item"]
+__all__ = ["manager_for", "lookup", "create_item", "check_strategy_robot"]
 
 
 @lru_cache(maxsize=8)
@@ -50,3 +51,17 @@ def lookup(kind: str, name: str, plugins: tuple[str, ...] = ()) -> Item:
 
 def create_item(kind: str, name: str, plugins: tuple[str, ...] = (), **kwargs: Any) -> Any:
     return lookup(kind, name, plugins).create(**kwargs)
+
+
+def check_strategy_robot(strategy: str, robot: str, plugins: tuple[str, ...] = ()) -> None:
+    """Refuse a robot the strategy does not drive (:func:`.contract.check_drives`), before any trial.
+
+    Unknown names are left to the lookups that report them (:func:`lookup`
+    of the strategy and the robot); only a known strategy's declaration is
+    checked here, from its registration, so the strategy is not built.
+    """
+    try:
+        item = lookup("strategy", strategy, plugins)
+    except PluginNotFoundError:
+        return
+    check_drives(item.name, item.meta, robot)

@@ -41,6 +41,7 @@ REGISTRATIONS = [
             "levels": [2, 3],
             "hand": "parallel gripper (YuMi smart gripper model; executed by pr2-gripper)",
             "benchmarks": ["inhand"],
+            "robots": ["pr2-gripper"],
         },
     )
 ]

@@ -41,12 +41,12 @@ REGISTRATIONS = [
         "push-grasp",
         make_push_grasp,
         "HERB Rubik's strategy: every grasp a BarrettHand push-grasp (thumb stop, outer fingers close)",
-        {"benchmarks": ["rubiks"], "robot": "herb"},
+        {"benchmarks": ["rubiks"], "robots": ["herb"]},
     ),
     Registration(
         "push-grasp-exact",
         make_push_grasp_exact,
         "HERB push-grasp with zero injected error (diagnostic)",
-        {"benchmarks": ["rubiks"], "robot": "herb"},
+        {"benchmarks": ["rubiks"], "robots": ["herb"]},
     ),
 ]

@@ -48,6 +48,11 @@ def _factory(variant: str):
 
 
 REGISTRATIONS = [
-    Registration(name, _factory(name), summary, {"levels": [1], "hand": "allegro", "variant": name})
+    Registration(
+        name,
+        _factory(name),
+        summary,
+        {"levels": [1], "robots": ["allegro"], "variant": name},
+    )
     for name, summary in _SUMMARIES.items()
 ]

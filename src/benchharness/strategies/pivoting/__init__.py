@@ -32,6 +32,11 @@ REGISTRATIONS = [
         "pivoting",
         make_pivoting,
         "Pivoting about the grasp axis by grip-force control, against the table (parallel gripper, Level I)",
-        {"levels": [1], "hand": "parallel gripper (pr2-gripper)", "benchmarks": ["inhand"]},
+        {
+            "levels": [1],
+            "hand": "parallel gripper (pr2-gripper)",
+            "benchmarks": ["inhand"],
+            "robots": ["pr2-gripper"],
+        },
     )
 ]

@@ -47,18 +47,18 @@ REGISTRATIONS = [
         "dead-reckoning",
         make_dead_reckoning,
         "PR2 Rubik's baseline: head-camera estimate, then dead reckoning through regrasps",
-        {"benchmarks": ["rubiks"], "robot": "pr2"},
+        {"benchmarks": ["rubiks"], "robots": ["pr2"]},
     ),
     Registration(
         "dead-reckoning-exact",
         make_dead_reckoning_exact,
         "PR2 Rubik's dead reckoning with zero injected error (diagnostic)",
-        {"benchmarks": ["rubiks"], "robot": "pr2"},
+        {"benchmarks": ["rubiks"], "robots": ["pr2"]},
     ),
     Registration(
         "sensor-aided",
         make_sensor_aided,
         "PR2 Rubik's baseline with pre-touch ToF re-localisation (EKF) before every grasp",
-        {"benchmarks": ["rubiks"], "robot": "pr2", "sensors": ["pretouch-tof"]},
+        {"benchmarks": ["rubiks"], "robots": ["pr2"], "sensors": ["pretouch-tof"]},
     ),
 ]
