@@ -474,3 +474,22 @@ def test_check_drives_accepts_declared_and_undeclared():
         check_drives("s", {"robots": ["pr2", "herb"]}, "allegro")
     with pytest.raises(TypeError):
         check_drives("s", {"robots": "pr2"}, "pr2")  # a string is not a list of names
+
+
+def test_docs_mismatch_example_prints_what_the_page_shows(tmp_path):
+    """The ``benchharness run`` example in docs/plugins.md, run as written (store in tmp)."""
+    import shlex
+
+    from click.testing import CliRunner
+
+    from benchharness.cli.run import run
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "plugins.md").read_text()
+    lines = doc.splitlines()
+    (k,) = [i for i, line in enumerate(lines) if line.startswith("$ benchharness run ")]
+    argv = shlex.split(lines[k])[3:]
+    store = tmp_path / "r.sqlite"
+    r = CliRunner().invoke(run, [*argv, "--store", str(store)])
+    assert r.exit_code == 2
+    assert r.output.strip() == lines[k + 1]
+    assert not store.exists()

@@ -27,7 +27,7 @@ def _sapien(config: PhysicsConfig | None = None):
 
 
 @hookimpl
-def benchharness_backends():
+def benchharness_backends() -> list[Registration]:
     return [
         Registration(
             "pybullet",

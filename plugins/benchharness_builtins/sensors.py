@@ -53,7 +53,7 @@ def _cube_kf(*, config=None, tof=None, initial=None, **kwargs):
 
 
 @hookimpl
-def benchharness_sensors():
+def benchharness_sensors() -> list[Registration]:
     return [
         Registration(
             "head-camera",

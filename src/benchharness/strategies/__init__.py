@@ -1,7 +1,8 @@
 """Manipulation strategies (baselines and planners).
 
-A module here that defines ``REGISTRATIONS: list[Registration]`` is picked up
-by the built-in ``strategies`` plugin; a module must import heavy
+Each strategy package defines ``REGISTRATIONS: list[Registration]`` (with
+the ``benchmarks`` and ``robots`` it declares) and is named in
+``benchharness_builtins.strategies.PACKAGES``; a package must import heavy
 dependencies (torch, simulators) lazily inside its factories so that listing
 plugins stays fast.
 """
