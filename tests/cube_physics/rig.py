@@ -6,12 +6,12 @@ is the cube's centre:
 * the **holder**: pads on the cube's ±x faces; which slabs it touches is set by
   the z spans of its pad segments (the three grasps of the paper's Fig. 2);
 * the **rotator**: a wrist (revolute about world z through the cube's axis,
-  3 N·m torque limit, DESIGN.md's figure) carrying two narrow pads on the ±y
+  3 N·m torque limit, the cube spike's figure) carrying two narrow pads on the ±y
   faces of the top slab.
 
 Every pad segment sits on its own prismatic joint driven as a capped spring
 (2000 N/m, pressed in far enough for its grip force, cap twice that), never a
-constant force (DESIGN.md found constant-force fingers let the cube drift).
+constant force (docs/benchmarks/cube_spike.md: constant-force fingers let the cube drift).
 A holder finger that spans slabs 0–1 *and* slab 2 is two such segments: a
 real fingertip is compliant and keeps touching every slab it spans, whereas a
 single rigid plate is lifted off slabs 0–1 by the first degree slab 2 turns
@@ -42,10 +42,10 @@ HOLDER_PAD_W = 0.060  #: holder pads span the whole face, so a turning slab's co
 ROTATOR_PAD_W = 0.020  #: narrow fingertips: they reach the holder's pads only past ~50°
 FINGER_K = 2000.0  #: N/m
 FINGER_D = 20.0  #: N·s/m
-GRIP = 20.0  #: N per finger (DESIGN.md)
+GRIP = 20.0  #: N per finger (docs/benchmarks/cube_spike.md)
 WRIST_K = 20.0  #: N·m/rad
 WRIST_D = 1.0  #: N·m·s/rad
-WRIST_TMAX = 3.0  #: N·m (DESIGN.md's wrist torque limit)
+WRIST_TMAX = 3.0  #: N·m (the cube spike's wrist torque limit, docs/benchmarks/cube_spike.md)
 OPEN = 0.045  #: finger position well clear of the cube
 FINGER_MASS = 0.07  #: kg, a realistic fingertip
 

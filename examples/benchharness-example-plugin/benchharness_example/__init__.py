@@ -38,7 +38,7 @@ def gantry_gripper_config():
         open=(0.04,),
         closed=(0.0,),
         grasp_actuators=("grip",),
-        stiffness=(2000.0, 2000.0),  # spring-like pads, as DESIGN.md found necessary
+        stiffness=(2000.0, 2000.0),  # spring-like pads (docs/benchmarks/cube_spike.md)
         damping=(20.0, 20.0),
         force_limit=(20.0, 20.0),
         finger_links=("finger_left", "finger_right"),

@@ -80,8 +80,8 @@ class Capabilities:
 class PhysicsConfig:
     """Engine-independent simulation settings.
 
-    Defaults are the ones DESIGN.md found to work for a 5.7 cm cube held by
-    parallel grippers on both engines.
+    Defaults are the ones the cube spike (docs/benchmarks/cube_spike.md) found
+    to work for a 5.7 cm cube held by parallel grippers on both engines.
     """
 
     timestep: float = 1.0 / 240.0  #: seconds per :meth:`Backend.step`

@@ -105,7 +105,7 @@ class PyBulletBackend(Backend):
     name = "pybullet"
     capabilities = PYBULLET_CAPABILITIES
     default_solver_iterations = (
-        50  # DESIGN.md: >= 50 at 1/240 s, else a 90 deg twist ends at ~102 deg
+        50  # docs/benchmarks/cube_spike.md: >= 50 at 1/240 s, else a 90 deg twist ends at ~102 deg
     )
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:

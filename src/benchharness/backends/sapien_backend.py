@@ -127,9 +127,7 @@ class _Body:
 class SapienBackend(Backend):
     name = "sapien"
     capabilities = SAPIEN_CAPABILITIES
-    default_solver_iterations = (
-        20  # DESIGN.md spike: TGS with 20 position iterations twists the cube correctly
-    )
+    default_solver_iterations = 20  # cube spike (docs/benchmarks/cube_spike.md): TGS with 20 position iterations twists the cube correctly
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
         super().__init__(config)

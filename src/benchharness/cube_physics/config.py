@@ -1,9 +1,9 @@
 """Typed parameters of the physical Rubik's cube, each with its default and why.
 
-The figures come from the spike recorded in DESIGN.md ("What a spike on both
-engines showed"): they made a 90° twist held by 20 N-per-finger grippers with
-pad friction 1.0 come out right on PyBullet and SAPIEN at 1/240 s. Everything
-a twist's outcome depends on is here so a sweep can vary it.
+The figures come from the spike recorded in docs/benchmarks/cube_spike.md:
+they made a 90° twist held by 20 N-per-finger grippers with pad friction 1.0
+come out right on PyBullet and SAPIEN at 1/240 s. Everything a twist's outcome
+depends on is here so a sweep can vary it.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Everything physical goes through :class:`~benchharness.backends.Backend`; the
 logical 54-facelet state is owned by the cube core and changed only from the
 joint angles the engine *measured* when a twist ends. Nothing here reads a
 gripper's commanded pose: whichever slabs the grippers actually hold, the
-contact forces decide what turns (DESIGN.md, "The physical Rubik's cube").
+contact forces decide what turns (docs/cube_physics.md, "Model").
 
 Life cycle::
 

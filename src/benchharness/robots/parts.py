@@ -446,7 +446,7 @@ class Gripper:
 
         Why: two fingers driven at "fully closed" with the same force cap are
         both saturated — constant forces with no centring, so the object
-        drifts sideways (DESIGN.md). Aiming each finger ``F / k`` past the
+        drifts sideways (docs/benchmarks/cube_spike.md). Aiming each finger ``F / k`` past the
         measured mid-width makes each an unsaturated spring pressing with
         ``F`` that pushes the object back to the middle if it moves.
         """

@@ -1,7 +1,7 @@
 """Typed parameters of the sensors and the cube pose filter, each with its default and why.
 
-Every error magnitude the Rubik's baselines depend on (DESIGN.md, "Error
-sources a simulation must model") is a named field here, so a sweep can vary
+Every error magnitude the Rubik's baselines depend on (docs/strategies.md,
+"Error sources") is a named field here, so a sweep can vary
 it and a report can print it. Units are SI (metres, radians) unless a name
 says ``_deg``; docs/sensors.md explains each figure.
 """

@@ -1,7 +1,7 @@
 """Parameters of the PR2 Rubik's baselines: scene, grasp geometry and every error source.
 
-Every magnitude is a named field with its default and why (DESIGN.md,
-"Error sources a simulation must model"). ``zero_error()`` gives the same
+Every magnitude is a named field with its default and why (docs/strategies.md,
+"Error sources"). ``zero_error()`` gives the same
 configuration with every injected error set to 0 (for tests and for telling
 the strategy's own mistakes from injected ones).
 """
@@ -42,7 +42,7 @@ class PR2RubiksConfig:
     #: stand-off the arm swings round at before a pre-grasp (m): the fingers open to 90 mm and a
     #: swing of the wrist at 7 cm can sweep the 57 mm cube.
     far_distance: float = 0.15
-    #: grip force per finger (N), as in tests/cube_physics/rig.py and DESIGN.md.
+    #: grip force per finger (N), as in tests/cube_physics/rig.py and docs/benchmarks/cube_spike.md.
     grip_force: float = 20.0
     #: force per finger (N) of the first, gentle close when the other hand already holds the cube:
     #: the first finger to touch then pushes with 3 N, a torque of at most ~0.15 N m at the 50 mm
