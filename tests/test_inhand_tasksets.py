@@ -60,3 +60,32 @@ def test_trial_task_names_the_row_from_the_outcome_or_the_set():
     assert trial_task("inhand-level1", 1, stored) == ("x-01", "apple", 2)
     assert trial_task("Rubiks-1-5", 1) is None
     assert trial_task("no-such-task", 1) is None
+
+
+def test_run_and_results_rows_name_task_and_object(tmp_path, monkeypatch):
+    """The CLI tables and JSON carry each in-hand trial's task id and object."""
+    import json
+    import sys
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from benchharness.cli.run import results, run
+
+    monkeypatch.syspath_prepend(str(Path(__file__).parent / "runner"))
+    sys.modules.pop("runner_testplugins", None)
+    store = str(tmp_path / "s.sqlite")
+    base = ["--robot", "test-stub", "--plugin", "runner_testplugins", "--workers", "0"]
+    base += ["--no-progress", "--store", store]
+    task = ["--task", "inhand-level3-dmg", "--strategy", "test-inhand", "--repeats", "2"]
+    r = CliRunner().invoke(run, [*task, *base, "--trials", "2,6"], catch_exceptions=False)
+    assert r.exit_code in (0, 1), r.output
+    assert "task id" in r.output and "cracker_box-dmg1" in r.output and "cracker box" in r.output
+    r = CliRunner().invoke(results, ["--store", store, "--json"], catch_exceptions=False)
+    rows = json.loads(r.output)
+    rows = rows["trials"] if isinstance(rows, dict) else rows
+    # trials 2 and 6 are repeats 1 and 2 of the second row (n = 4)
+    assert sorted((t["trial"], t["task_id"], t["object"], t["repeat"]) for t in rows) == [
+        (2, "cracker_box-dmg1", "cracker box", 1),
+        (6, "cracker_box-dmg1", "cracker box", 2),
+    ]
