@@ -1,8 +1,10 @@
 """The twelve YCB objects of the in-hand manipulation benchmark, from published figures.
 
-The real YCB meshes cannot be downloaded here, so each object is generated
-from its published dimensions and mass. Shapes are deliberately simple; each
-spec's ``simplification`` says how. All lengths below are metres.
+Each spec names its vendored YCB scan and the frame the published data uses
+it in (``scan``, the default model, :mod:`.ycb`), and describes the
+simplified model generated from the published dimensions and mass
+(``geometry``, ``model="generated"``). Generated shapes are deliberately
+simple; each spec's ``simplification`` says how. All lengths below are metres.
 
 Sources (see :data:`CALLI_2015` and friends):
 
