@@ -167,12 +167,17 @@ def test_committed_files_equal_fresh_conversion(tmp_path):
         )
 
 
-def test_hand_pose_task_set_marks_dmg_rows():
+def test_level1_file_holds_exactly_the_100_published_level1_tasks():
+    """Paper IV-A1: 10 objects x 2 initial x 5 desired grasps = 100 Level I tasks; the four
+    DMG hand-pose rows of hand_poses.ods live in their own Level III file."""
     from benchharness.inhand.fileformat import read_tasks
 
     t = read_tasks(TASKS / "level1_hand_poses.csv")
-    assert len(t) == 104
-    dmg_rows = t.extra["set"] == "dmg-level3"
-    assert sorted(t.object[dmg_rows]) == sorted(TABLE_III)
-    assert np.all(t.level[dmg_rows] == 3) and np.all(t.level[~dmg_rows] == 1)
+    assert len(t) == 100 and np.all(t.level == 1) and set(t.extra["set"]) == {"allegro-level1"}
+    assert len(set(t.object)) == 10
+    assert all(np.sum(t.object == o) == 10 for o in set(t.object))
     assert len(set(t.task_id)) == len(t)
+    d = read_tasks(TASKS / "level3_dmg_hand_poses.csv")
+    assert sorted(d.object) == sorted(TABLE_III)
+    assert np.all(d.level == 3) and set(d.extra["set"]) == {"dmg-level3"}
+    assert not set(d.task_id) & set(t.task_id)

@@ -57,7 +57,7 @@ ALL = [s.name for s in CATALOG]
 
 @pytest.fixture(scope="module", params=ALL)
 def model(request):
-    return load_object(request.param)
+    return load_object(request.param, model="generated")
 
 
 # ---------------------------------------------------------------------------- catalogue
@@ -107,7 +107,7 @@ def test_unknown_name_lists_the_valid_ones():
     for name in PUBLISHED_NAMES:
         assert repr(name) in msg
     with pytest.raises(LookupError):  # a LookupError, catchable as such
-        load_object("mug")
+        load_object("mug", model="generated")
 
 
 # ---------------------------------------------------------------------------- meshes vs analytic shapes
@@ -115,7 +115,7 @@ def test_unknown_name_lists_the_valid_ones():
 
 def test_sphere_mesh_volume_and_area():
     r = 0.0375
-    m = load_object("apple").surface
+    m = load_object("apple", model="generated").surface
     assert m.volume == pytest.approx(4 / 3 * np.pi * r**3, rel=0.01)
     assert m.area == pytest.approx(4 * np.pi * r**2, rel=0.01)
     assert m.volume < 4 / 3 * np.pi * r**3  # inscribed: vertices on the sphere
@@ -124,7 +124,7 @@ def test_sphere_mesh_volume_and_area():
 
 def test_cylinder_mesh_volume_and_area():
     r, length = 0.0425, 0.033
-    m = load_object("tuna fish can").surface
+    m = load_object("tuna fish can", model="generated").surface
     assert m.volume == pytest.approx(np.pi * r**2 * length, rel=0.01)
     assert m.area == pytest.approx(2 * np.pi * r**2 + 2 * np.pi * r * length, rel=0.01)
 
@@ -139,7 +139,7 @@ def test_cylinder_mesh_volume_and_area():
 )
 def test_box_mesh_volume_and_area_are_exact(name, size):
     a, b, c = size
-    m = load_object(name).surface
+    m = load_object(name, model="generated").surface
     assert m.volume == pytest.approx(a * b * c, rel=1e-9)
     assert m.area == pytest.approx(2 * (a * b + b * c + a * c), rel=1e-9)
 
@@ -147,7 +147,7 @@ def test_box_mesh_volume_and_area_are_exact(name, size):
 def test_box_union_volume_is_the_sum_of_its_boxes():
     for spec in CATALOG:
         if isinstance(spec.geometry, BoxGeometry):
-            m = load_object(spec.name).surface
+            m = load_object(spec.name, model="generated").surface
             assert m.volume == pytest.approx(
                 sum(b.volume for b in spec.geometry.boxes), rel=1e-9
             ), spec.name
@@ -156,7 +156,7 @@ def test_box_union_volume_is_the_sum_of_its_boxes():
 def test_sweep_mesh_volume_matches_its_profile_integral():
     for spec in CATALOG:
         if isinstance(spec.geometry, SweepGeometry):
-            m = load_object(spec.name).surface
+            m = load_object(spec.name, model="generated").surface
             tol = 0.07 if spec.name == "fork" else 0.03
             assert m.volume == pytest.approx(spec.geometry.profile.volume(), rel=tol), spec.name
             assert m.volume < spec.geometry.profile.volume()  # inscribed polygons: never larger
@@ -213,7 +213,7 @@ def test_collision_model_carries_the_published_mass(model):
 
 
 def test_sphere_mass_properties():
-    m = load_object("orange")
+    m = load_object("orange", model="generated")
     (s,) = m.collision
     assert isinstance(s, Sphere) and s.radius == pytest.approx(0.0365)
     assert np.allclose(m.mass.com, 0.0)
@@ -221,7 +221,7 @@ def test_sphere_mass_properties():
 
 
 def test_box_mass_properties():
-    m = load_object("cracker box")
+    m = load_object("cracker box", model="generated")
     (s,) = m.collision
     assert isinstance(s, Box)
     a, b, c = 0.06, 0.158, 0.21
@@ -230,7 +230,7 @@ def test_box_mass_properties():
 
 
 def test_cylinder_mass_properties():
-    m = load_object("tuna fish can")
+    m = load_object("tuna fish can", model="generated")
     (s,) = m.collision
     assert isinstance(s, Cylinder)
     mass, r, length = 0.171, 0.0425, 0.033
@@ -308,7 +308,7 @@ def test_user_mesh_collision_hull_of_a_nonconvex_mesh(tmp_path):
 
 
 def test_generated_models_are_cached_but_returned_as_copies():
-    a = load_object("banana")
+    a = load_object("banana", model="generated")
     a.surface.vertices += 1.0
     b = load_object("banana", resolution=DEFAULT_RESOLUTION)
     assert np.abs(b.surface.bounds).max() < 0.2

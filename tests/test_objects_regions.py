@@ -19,12 +19,14 @@ from benchharness.objects import contact_region, load_object, vertex_distances
 
 @pytest.fixture(scope="module")
 def box():
-    return load_object("cracker box").surface  # 158 x 210 mm faces at x = +-30 mm
+    return load_object(
+        "cracker box", model="generated"
+    ).surface  # 158 x 210 mm faces at x = +-30 mm
 
 
 @pytest.fixture(scope="module")
 def orange():
-    return load_object("orange").surface
+    return load_object("orange", model="generated").surface
 
 
 @pytest.mark.parametrize("metric, tol", [("euclidean", 0.05), ("geodesic", 0.10)])
@@ -44,7 +46,7 @@ def test_disc_on_a_flat_face_has_area_pi_r2(box, metric, tol, radius):
 
 def test_euclidean_disc_jumps_a_thin_object_geodesic_does_not():
     # gelatin box: 28 mm thick; a 30 mm disc centred on a big face
-    box = load_object("gelatin box").surface
+    box = load_object("gelatin box", model="generated").surface
     p = [0.05, 0.0, 0.0]  # projects to the x = +14 mm face centre
     e = contact_region(box, p, 0.03, "euclidean")
     g = contact_region(box, p, 0.03, "geodesic")
@@ -74,7 +76,9 @@ def test_euclidean_cap_on_a_sphere_is_pi_c2(orange):
 
 def test_exact_geodesic_agrees_on_a_flat_face(box):
     pytest.importorskip("pygeodesic")
-    small = load_object("gelatin box").surface  # 85 x 73 mm face at x = +14 mm; small and fast
+    small = load_object(
+        "gelatin box", model="generated"
+    ).surface  # 85 x 73 mm face at x = +14 mm; small and fast
     reg = contact_region(small, [0.02, 0.0, 0.0], 0.02, "geodesic_exact")
     assert reg.area == pytest.approx(np.pi * 0.02**2, rel=0.05)
 

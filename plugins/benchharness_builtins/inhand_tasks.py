@@ -18,6 +18,10 @@ TASK_SETS = {
         "level1_hand_poses.csv",
         "In-hand Level I: desired palm pose changes on 10 YCB objects (published hand_poses.ods)",
     ),
+    "inhand-level3-dmg-hand-poses": (
+        "level3_dmg_hand_poses.csv",
+        "In-hand Level III: the 4 DMG tasks' hand poses as listed in hand_poses.ods (no contacts)",
+    ),
     "inhand-level3-dmg": (
         "level3_dmg_tasks.csv",
         "In-hand Level III: contact + pose tasks for a parallel gripper (published DMG.ods)",

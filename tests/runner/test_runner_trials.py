@@ -148,7 +148,9 @@ def test_inhand_trials_are_scored_by_score_trials(make_spec):
         assert r.score == pytest.approx(float(s.err_pos[0]))
         assert o["metrics"]["err_pos_percent"] == pytest.approx(float(s.err_pos_percent[0]))
     assert all(r.score is None and r.outcome["dropped"] for r in dropped)
-    assert [r.outcome["repeat"] for r in recs[:3]] == [1, 2, 3]
+    # repeat-major numbering (docs/runner.md): trials 1, 5, 9 are the first task row, repeats 1-3
+    assert [recs[k].outcome["repeat"] for k in (0, 4, 8)] == [1, 2, 3]
+    assert len({recs[k].outcome["task_id"] for k in (0, 4, 8)}) == 1
 
 
 def test_sensors_are_slots_with_their_own_streams(make_spec):

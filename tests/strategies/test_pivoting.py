@@ -43,7 +43,9 @@ def _rig(
     item = task_item("inhand-level1-pivoting", 0)  # gelatin box, -18.3 deg
     ctx, b = make_context(backend_name, item, seed)
     cfg = ExecutionConfig(setup=setup or SetupConfig(), grip=grip or GripConfig(), hold=SHORT_HOLD)
-    model = load_object("gelatin box")
+    model = load_object(
+        "gelatin box", model="generated"
+    )  # the pivoting tasks use the generated frames
     rest = rest_pose("gelatin box", (1, 0, 0), 0.0)
     rig = TableRig(b, ctx.robot, model, cfg, ctx.rng)
     rig.build(rest)

@@ -289,10 +289,14 @@ def _sweep(spec, store, workers, trial_sel, retry_failed, progress, video=None):
 
 
 def _trial_json(t) -> dict[str, Any]:
+    from ..runner.tasks import trial_task
+
+    tid = trial_task(t.task, t.trial_index, t.outcome)
     return {
         "run_key": t.run_key,
         "trial": t.trial_index,
         "task": t.task,
+        **({"task_id": tid[0], "object": tid[1], "repeat": tid[2]} if tid else {}),
         "robot": t.robot,
         "strategy": t.strategy,
         "sensors": t.sensors,
@@ -314,12 +318,18 @@ def _trial_json(t) -> dict[str, Any]:
 def _trials_table(rows, title: str, show_run: bool = False):
     from rich.table import Table
 
+    from ..runner.tasks import trial_task
+
     table = Table(title=title)
     if show_run:
         for c in ("task", "method", "seed"):
             table.add_column(c, no_wrap=True)
+    # in-hand trials: which task row and object (docs/runner.md, trial numbering)
+    ids = [trial_task(t.task, t.trial_index, t.outcome) for t in rows]
+    inhand = any(ids)
     for c, j in (
         ("trial", "right"),
+        *((("task id", "left"), ("object", "left")) if inhand else ()),
         ("status", "left"),
         ("score", "right"),
         ("cause", "left"),
@@ -328,11 +338,12 @@ def _trials_table(rows, title: str, show_run: bool = False):
         ("message", "left"),
     ):
         table.add_column(c, justify=j)
-    for t in rows:
+    for t, tid in zip(rows, ids):
         lead = [_esc(t.task), _esc(t.method), str(t.seed)] if show_run else []
         table.add_row(
             *lead,
             str(t.trial_index),
+            *([_esc(tid[0]), _esc(tid[1])] if tid else ["", ""] if inhand else []),
             t.status.value,
             _fmt(t.score, 3),
             t.failure_cause.value if t.failure_cause else "",
@@ -783,6 +794,12 @@ def compare(
                 (b, [t for t in store.trials(run_key=spec.run_key) if t.trial_index in sel])
             )
     data = compare_backends(runs, required)
+    from ..runner.tasks import trial_task
+
+    for row in data["trials"]:  # in-hand trials: which task row and object
+        tid = trial_task(task, row["trial"])
+        if tid:
+            row["task_id"], row["object"] = tid[0], tid[1]
     if as_json:
         emit_json({"task": task, "benchmark": benchmark, "backends": list(names), **data})
         return
@@ -791,12 +808,18 @@ def compare(
     console = _console()
     t = Table(title=f"{task}: {strategy} on {robot}, seed {seed} — per backend")
     t.add_column("trial", justify="right")
+    inhand = any("task_id" in row for row in data["trials"])
+    if inhand:
+        t.add_column("task id")
+        t.add_column("object")
     for b in names:
         t.add_column(f"{b}: status", no_wrap=True)
         t.add_column(f"{b}: score", justify="right")
         t.add_column(f"{b}: sim s", justify="right")
     for row in data["trials"]:
         cells = [str(row["trial"])]
+        if inhand:
+            cells += [_esc(row.get("task_id", "")), _esc(row.get("object", ""))]
         for b in names:
             c = row[b]
             if c is None:

@@ -6,11 +6,14 @@ Source: the dataset repository of Cruciani, Sundaralingam et al.,
 :mod:`benchharness.inhand.fileformat`:
 
 ``level1_hand_poses.csv``
-    ``dataset/hand_poses.ods``: 100 Level I palm-pose tasks (10 objects x
-    2 initial x 5 desired grasps) plus 4 rows of a different kind -- gelatin
-    box, spatula, potted meat can, cracker box -- that are the hand poses of
-    the YuMi/DMG Level III tasks (gripper pose = fingertip midpoint). Those
-    are kept, with ``set = dmg-level3`` and a note naming the DMG task.
+    ``dataset/hand_poses.ods``: the 100 Level I palm-pose tasks (10 objects
+    x 2 initial x 5 desired grasps), ``set = allegro-level1``.
+``level3_dmg_hand_poses.csv``
+    The 4 other rows of ``hand_poses.ods`` -- gelatin box, spatula, potted
+    meat can, cracker box -- which are the hand poses of the YuMi/DMG Level
+    III tasks (gripper pose = fingertip midpoint), with ``set =
+    dmg-level3`` and a note naming the DMG task. A Level III set of their
+    own, so that ``level1_hand_poses.csv`` holds exactly the Level I tasks.
 ``level3_dmg_tasks.csv``
     The four DMG tasks of ``results/yumi_lvl_3/DMG.ods`` as Level III tasks:
     hand poses (fingertip midpoint + given quaternion) and contact points.
@@ -51,6 +54,7 @@ DMG = Path("results/yumi_lvl_3/DMG.ods")
 
 OUTPUT_FILES = (
     "level1_hand_poses.csv",
+    "level3_dmg_hand_poses.csv",
     "level3_dmg_tasks.csv",
     "published/allegro_lvl1_relaxed_rigidity.csv",
     "published/yumi_lvl3_dmg.csv",
@@ -298,8 +302,20 @@ def _allegro_results(source: Path, hand_tasks: TaskSet) -> ResultSet:
     )
 
 
+def _rows(ts: TaskSet, keep: np.ndarray) -> TaskSet:
+    """The rows ``keep`` (a boolean mask) of a contact-free hand-pose task set."""
+    return TaskSet(
+        task_id=ts.task_id[keep],
+        object=ts.object[keep],
+        level=ts.level[keep],
+        initial=ts.initial[keep],
+        desired=ts.desired[keep],
+        extra={k: v[keep] for k, v in ts.extra.items()},
+    )
+
+
 def convert_bih(source: str | Path | None = None, out: str | Path | None = None) -> ImportReport:
-    """Convert the dataset at ``source`` into the four files under ``out``."""
+    """Convert the dataset at ``source`` into the five files under ``out``."""
     from ..paths import tasks_dir
 
     source = Path(source) if source is not None else default_source()
@@ -312,10 +328,11 @@ def convert_bih(source: str | Path | None = None, out: str | Path | None = None)
     allegro = _allegro_results(source, hand)
     dmg_res = _dmg_results(dmg)
     paths = [out / f for f in OUTPUT_FILES]
-    write_tasks(hand, paths[0])
-    write_tasks(dmg_tasks, paths[1])
-    write_results(allegro, paths[2])
-    write_results(dmg_res, paths[3])
+    write_tasks(_rows(hand, hand.level == 1), paths[0])
+    write_tasks(_rows(hand, hand.level == 3), paths[1])
+    write_tasks(dmg_tasks, paths[2])
+    write_results(allegro, paths[3])
+    write_results(dmg_res, paths[4])
     counts = {
         "level1_tasks": int(np.sum(hand.level == 1)),
         "dmg_hand_pose_rows": int(np.sum(hand.level == 3)),

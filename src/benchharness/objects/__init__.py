@@ -1,17 +1,18 @@
 """The YCB objects of the in-hand manipulation benchmark.
 
-The real YCB meshes are not downloadable here, so each of the twelve objects
-is generated from its published dimensions and mass as two simplified
-models: a surface mesh (watertight, near-uniform triangles, for the contact
-metrics of Algorithm 1) and a collision model of backend primitives (for
-simulation). A user with the real meshes passes ``mesh_path=`` and gets
-those instead, with the published mass. Contact regions ``C_i``/``C_d`` are
-defined on the surface mesh as geodesic or Euclidean discs.
+Each of the twelve objects is, by default, its real YCB scan (vendored, see
+:mod:`.ycb`) in the frame the published data uses, with its convex hull or
+V-HACD pieces for collision and the published mass. ``model="generated"``
+gives the simplified models generated from the published dimensions (a
+watertight surface with near-uniform triangles and a collision model of
+backend primitives); ``mesh_path=`` substitutes any mesh. Contact regions
+``C_i``/``C_d`` are defined on the surface mesh as geodesic or Euclidean
+discs.
 
 >>> from benchharness.objects import load_object, contact_region
 >>> can = load_object("potted meat can")
->>> can.surface.is_watertight, round(can.mass.mass, 3)
-(True, 0.37)
+>>> can.source, len(can.surface.faces), round(can.mass.mass, 3)
+('ycb', 16384, 0.37)
 >>> region = contact_region(can.surface, [0.025, 0.0, 0.0], radius=0.015)
 
 See docs/objects.md for the object table, frames and sources.

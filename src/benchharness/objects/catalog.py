@@ -1,8 +1,10 @@
 """The twelve YCB objects of the in-hand manipulation benchmark, from published figures.
 
-The real YCB meshes cannot be downloaded here, so each object is generated
-from its published dimensions and mass. Shapes are deliberately simple; each
-spec's ``simplification`` says how. All lengths below are metres.
+Each spec names its vendored YCB scan and the frame the published data uses
+it in (``scan``, the default model, :mod:`.ycb`), and describes the
+simplified model generated from the published dimensions and mass
+(``geometry``, ``model="generated"``). Generated shapes are deliberately
+simple; each spec's ``simplification`` says how. All lengths below are metres.
 
 Sources (see :data:`CALLI_2015` and friends):
 
@@ -41,7 +43,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .boxunion import AABox
-from .spec import BoxGeometry, Citation, ObjectSpec, SweepGeometry
+from .spec import BoxGeometry, Citation, ObjectSpec, SweepGeometry, YcbScan
 from .sweep import Segment, SweepProfile, _dense_samples
 
 __all__ = ["CATALOG", "CALLI_2015", "DRAKE_YCB", "DUPLO_SCALE", "ESTIMATE"]
@@ -213,6 +215,23 @@ def _box(size: tuple[float, float, float]) -> BoxGeometry:
     return BoxGeometry((AABox.centred(size),))
 
 
+# ---------------------------------------------------------------------------- scan frames
+
+# What each scan's frame rests on (measured by tests/test_objects_ycb.py against
+# tasks/inhand/level3_dmg_tasks.csv, converted from DMG.ods).
+_DMG_YCB = (
+    "DMG.ods (Level III): the four published fingertip contacts lie within 4 mm of the scan "
+    "in its own YCB frame and 21-85 mm off when it is centred on its bounding box"
+)
+_DMG_BBOX = (
+    "DMG.ods (Level III): the four published fingertip contacts lie within 4.5 mm of the scan "
+    "centred on its bounding box and 10-21 mm off in its own YCB frame"
+)
+_NOT_FIXED = (
+    "not fixed by the published data (Level I gives palm poses, not contacts, and the "
+    "simulated set-up solves the object's placement in the hand); the scan's own YCB frame"
+)
+
 # ---------------------------------------------------------------------------- the catalog
 
 CATALOG: tuple[ObjectSpec, ...] = (
@@ -220,6 +239,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="apple",
         ycb_id="013",
         ycb_name="013_apple",
+        scan=YcbScan("013_apple", "ycb", _NOT_FIXED, "hull"),
         published_mm=(75.0,),
         bbox_mm=(75.0, 75.0, 75.0),
         mass_kg=0.068,
@@ -232,6 +252,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="banana",
         ycb_id="011",
         ycb_name="011_banana",
+        scan=YcbScan("011_banana", "ycb", _NOT_FIXED, "decompose"),
         published_mm=(36.0, 190.0),
         bbox_mm=(190.0, 36.0, None),
         mass_kg=0.066,
@@ -249,6 +270,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="gelatin box",
         ycb_id="009",
         ycb_name="009_gelatin_box",
+        scan=YcbScan("009_gelatin_box", "bbox_centre", _DMG_BBOX, "hull"),
         published_mm=(28.0, 85.0, 73.0),
         bbox_mm=(28.0, 85.0, 73.0),
         mass_kg=0.097,
@@ -261,6 +283,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="Lego Duplo",
         ycb_id="073",
         ycb_name="073_lego_duplo",
+        scan=YcbScan("073-a_lego_duplo", "ycb", _NOT_FIXED, "decompose"),
         published_mm=(63.7, 31.7, 22.6),
         bbox_mm=(63.7, 31.7, 22.6),
         mass_kg=0.011,
@@ -281,6 +304,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="fork",
         ycb_id="030",
         ycb_name="030_fork",
+        scan=YcbScan("030_fork", "ycb", _NOT_FIXED, "decompose"),
         published_mm=(14.0, 20.0, 198.0),
         bbox_mm=(198.0, 20.0, 14.0),
         mass_kg=0.034,
@@ -298,6 +322,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="orange",
         ycb_id="017",
         ycb_name="017_orange",
+        scan=YcbScan("017_orange", "ycb", _NOT_FIXED, "hull"),
         published_mm=(73.0,),
         bbox_mm=(73.0, 73.0, 73.0),
         mass_kg=0.047,
@@ -310,6 +335,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="airplane toy",
         ycb_id="072",
         ycb_name="072_toy_airplane",
+        scan=YcbScan("072-a_toy_airplane", "ycb", _NOT_FIXED, "decompose"),
         published_mm=(171.0, 266.0, 280.0),
         bbox_mm=(280.0, 266.0, 171.0),
         mass_kg=0.570,
@@ -331,6 +357,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="Phillips-head screwdriver",
         ycb_id="043",
         ycb_name="043_phillips_screwdriver",
+        scan=YcbScan("043_phillips_screwdriver", "ycb", _NOT_FIXED, "decompose"),
         published_mm=(31.0, 215.0),
         bbox_mm=(31.0, 31.0, 215.0),
         mass_kg=0.097,
@@ -350,6 +377,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="spatula",
         ycb_id="033",
         ycb_name="033_spatula",
+        scan=YcbScan("033_spatula", "ycb", _DMG_YCB, "decompose"),
         published_mm=(35.0, 83.0, 350.0),
         bbox_mm=(350.0, 83.0, 35.0),
         mass_kg=0.0515,
@@ -367,6 +395,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="tuna fish can",
         ycb_id="007",
         ycb_name="007_tuna_fish_can",
+        scan=YcbScan("007_tuna_fish_can", "ycb", _NOT_FIXED, "hull"),
         published_mm=(85.0, 33.0),
         bbox_mm=(85.0, 85.0, 33.0),
         mass_kg=0.171,
@@ -384,6 +413,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="potted meat can",
         ycb_id="010",
         ycb_name="010_potted_meat_can",
+        scan=YcbScan("010_potted_meat_can", "ycb", _DMG_YCB, "decompose"),
         published_mm=(50.0, 97.0, 82.0),
         bbox_mm=(50.0, 97.0, 82.0),
         mass_kg=0.370,
@@ -397,6 +427,7 @@ CATALOG: tuple[ObjectSpec, ...] = (
         name="cracker box",
         ycb_id="003",
         ycb_name="003_cracker_box",
+        scan=YcbScan("003_cracker_box", "bbox_centre", _DMG_BBOX, "hull"),
         published_mm=(60.0, 158.0, 210.0),
         bbox_mm=(60.0, 158.0, 210.0),
         mass_kg=0.411,

@@ -101,3 +101,23 @@ def mass_properties(shapes: Sequence[Shape], mass: float) -> MassProperties:
     return MassProperties(
         mass=float(mass), com=np.asarray(com, float), inertia=inertia, volume=float(vol)
     )
+
+
+def solid_mass_properties(mesh: trimesh.Trimesh, mass: float) -> MassProperties:
+    """Properties of the solid a closed surface bounds, filled uniformly with ``mass``.
+
+    For the watertight YCB scans: the scan's own volume, not a collision
+    model's (convex hulls and V-HACD pieces are larger, and V-HACD pieces
+    may overlap, which :func:`mass_properties` would count twice).
+    """
+    if not mesh.is_watertight or mesh.volume <= 0:
+        raise ValueError("solid mass properties need a closed, outward-oriented surface")
+    m = mesh.copy()
+    m.density = 1.0
+    vol = float(m.volume)
+    return MassProperties(
+        mass=float(mass),
+        com=np.asarray(m.center_mass, float),
+        inertia=np.asarray(m.moment_inertia, float) * (mass / vol),
+        volume=vol,
+    )

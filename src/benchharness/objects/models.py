@@ -1,11 +1,12 @@
-"""Build an object's surface mesh and collision model, or take them from a real mesh.
+"""An object's surface mesh and collision model: the real YCB scan, a generated model, or the user's mesh.
 
-``load_object("potted meat can")`` generates both representations from the
-published dimensions (see :mod:`.catalog`); ``load_object(name,
-mesh_path=...)`` uses the user's mesh (e.g. the real YCB ``google_16k``
-scan) for the surface and its convex hull, or a convex decomposition, for
-collision, keeping the published mass. The user's mesh keeps its own frame:
-with the real YCB mesh, the published in-hand poses apply unchanged.
+``load_object("potted meat can")`` gives the vendored YCB scan (see
+:mod:`.ycb`) in the frame the published data uses (``spec.scan.frame``),
+with its convex hull or its vendored V-HACD pieces for collision.
+``load_object(name, model="generated")`` (or any ``resolution=``) builds
+both representations from the published dimensions instead (see
+:mod:`.catalog`); ``load_object(name, mesh_path=...)`` uses the user's mesh
+in its own frame. The published mass is kept in every case.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from ..backends.interface import Box, Cylinder, MeshShape, Shape, Sphere
 from ..geometry import Pose
 from .boxunion import mesh_box_union
 from .catalog import CATALOG
-from .mass import MassProperties, mass_properties
+from .mass import MassProperties, mass_properties, solid_mass_properties
 from .spec import BoxGeometry, ObjectSpec, SweepGeometry
 from .sweep import mesh_sweep, pieces_as_meshes
 
@@ -47,6 +48,7 @@ __all__ = [
 DEFAULT_RESOLUTION = 3e-3
 
 CollisionMode = Literal["hull", "decompose"]
+ModelKind = Literal["ycb", "generated"]
 
 
 class UnknownObjectError(LookupError):
@@ -88,8 +90,11 @@ class ObjectModel:
 
     ``surface`` is in the object frame (metres); ``collision`` are backend
     shapes with poses in the same frame; ``mass`` carries the published mass
-    spread uniformly over the collision volume. ``source`` is ``"generated"``
-    or the path of a user-supplied mesh.
+    spread uniformly over the collision volume. ``source`` is ``"ycb"``
+    (the vendored scan), ``"generated"`` or the path of a user-supplied mesh.
+    ``frame_offset`` is the translation (m) applied to the mesh file's
+    coordinates to get the object frame (non-zero for a scan used centred on
+    its bounding box); ``resolution`` is the generated models' edge length.
     """
 
     spec: ObjectSpec
@@ -98,6 +103,7 @@ class ObjectModel:
     mass: MassProperties
     source: str
     resolution: float | None
+    frame_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @property
     def name(self) -> str:
@@ -256,38 +262,86 @@ def _from_mesh(spec: ObjectSpec, path: Path, collision: CollisionMode) -> Object
     )
 
 
+@functools.lru_cache(maxsize=16)
+def _scanned(name: str) -> ObjectModel:
+    from .ycb import read_parts, read_scan, scan_offset
+
+    spec = get_spec(name)
+    offset = scan_offset(spec.scan.file, spec.scan.frame)
+    surface = read_scan(spec.scan.file)
+    surface.apply_translation(offset)
+    surface.metadata["name"] = spec.name
+    if spec.scan.collision == "hull":
+        pieces = [(np.asarray(surface.convex_hull.vertices), np.asarray(surface.convex_hull.faces))]
+    else:
+        pieces = [(v + offset, f) for v, f in read_parts(spec.scan.file)]
+    shapes: list[Shape] = [MeshShape(vertices=v, faces=f) for v, f in pieces]
+    # the scan's own solid where it is closed (10 of 12); the gelatin box's
+    # and tuna can's scans have holes, so their hull (one piece) carries the mass
+    closed = surface.is_watertight and surface.volume > 0
+    return ObjectModel(
+        spec=spec,
+        surface=surface,
+        collision=tuple(shapes),
+        mass=(
+            solid_mass_properties(surface, spec.mass_kg)
+            if closed
+            else mass_properties(shapes, spec.mass_kg)
+        ),
+        source="ycb",
+        resolution=None,
+        frame_offset=(float(offset[0]), float(offset[1]), float(offset[2])),
+    )
+
+
 def load_object(
     name: str,
     *,
-    resolution: float = DEFAULT_RESOLUTION,
+    model: ModelKind | None = None,
+    resolution: float | None = None,
     mesh_path: str | Path | None = None,
     collision: CollisionMode = "hull",
 ) -> ObjectModel:
     """The model of a benchmark object.
 
-    Generated from published dimensions with target edge length
-    ``resolution`` (m), or, with ``mesh_path``, built on the user's mesh
-    (any format trimesh reads, in metres, e.g. a YCB ``textured.obj``):
-    that mesh is the surface, and the collision model is its convex hull
-    (``collision="hull"``, default, one piece: right for the boxes, cans and
-    fruit, too fat for the banana, fork, spatula and airplane) or a V-HACD
-    convex decomposition (``collision="decompose"``, needs ``vhacdx``). The
-    published mass is kept in both cases.
+    ``model="ycb"`` (the default): the real YCB scan (vendored, 16 384
+    triangles), in the frame of the published data (``spec.scan.frame``),
+    colliding as its convex hull or its vendored V-HACD pieces
+    (``spec.scan.collision``). ``model="generated"``: built from the
+    published dimensions with target edge length ``resolution`` (m, default
+    :data:`DEFAULT_RESOLUTION`); passing ``resolution`` alone implies it,
+    since only generated meshes have one. ``mesh_path``: the user's mesh
+    (any format trimesh reads, in metres, in its own frame) as the surface,
+    colliding as its convex hull (``collision="hull"``) or a V-HACD
+    decomposition (``collision="decompose"``, needs ``vhacdx``). The
+    published mass is kept in every case.
 
-    Generated models are cached per (name, resolution); the returned mesh is a
+    Models are cached per (name, kind, resolution); the returned mesh is a
     copy, so callers may modify it.
     """
     spec = get_spec(name)
     if mesh_path is not None:
+        if model is not None or resolution is not None:
+            raise ValueError("mesh_path replaces the model: pass neither model= nor resolution=")
         return _from_mesh(spec, Path(mesh_path), collision)
-    if resolution <= 0:
-        raise ValueError("resolution must be a positive length in metres")
-    model = _generated(spec.name, float(resolution))
+    kind = model if model is not None else ("generated" if resolution is not None else "ycb")
+    if kind == "ycb":
+        if resolution is not None:
+            raise ValueError("resolution applies to model='generated'; the YCB scan has its own")
+        cached = _scanned(spec.name)
+    elif kind == "generated":
+        res = DEFAULT_RESOLUTION if resolution is None else float(resolution)
+        if res <= 0:
+            raise ValueError("resolution must be a positive length in metres")
+        cached = _generated(spec.name, res)
+    else:
+        raise ValueError(f"model must be 'ycb' or 'generated', not {model!r}")
     return ObjectModel(
-        spec=model.spec,
-        surface=model.surface.copy(),
-        collision=model.collision,
-        mass=model.mass,
-        source=model.source,
-        resolution=model.resolution,
+        spec=cached.spec,
+        surface=cached.surface.copy(),
+        collision=cached.collision,
+        mass=cached.mass,
+        source=cached.source,
+        resolution=cached.resolution,
+        frame_offset=cached.frame_offset,
     )

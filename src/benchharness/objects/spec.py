@@ -14,7 +14,15 @@ from typing import Literal
 from .boxunion import AABox
 from .sweep import SweepProfile
 
-__all__ = ["Citation", "SweepGeometry", "BoxGeometry", "Geometry", "ObjectSpec"]
+__all__ = [
+    "Citation",
+    "SweepGeometry",
+    "BoxGeometry",
+    "Geometry",
+    "MeshFrame",
+    "ObjectSpec",
+    "YcbScan",
+]
 
 
 @dataclass(frozen=True)
@@ -49,6 +57,31 @@ class BoxGeometry:
 
 Geometry = SweepGeometry | BoxGeometry
 
+#: Where the published in-hand data puts the object's origin relative to the
+#: YCB scan: ``"ycb"`` = the scan's own frame as distributed; ``"bbox_centre"``
+#: = the same axes, origin moved to the centre of the scan's axis-aligned
+#: bounding box.
+MeshFrame = Literal["ycb", "bbox_centre"]
+
+
+@dataclass(frozen=True)
+class YcbScan:
+    """The real YCB mesh of an object and the frame the published data uses it in.
+
+    ``file`` names the vendored scan under ``objects/ycb_meshes/``.
+    ``frame`` is measured from the data where the data fixes it (the Level
+    III fingertip contacts of ``DMG.ods`` lie on the surface in that frame;
+    ``tests/test_objects_ycb.py`` holds them to it), and ``frame_evidence``
+    says what it rests on. ``collision`` is the collision model: the scan's
+    convex hull where the object is (nearly) convex, the vendored V-HACD
+    pieces where the hull would fill a concavity a finger can reach.
+    """
+
+    file: str
+    frame: MeshFrame
+    frame_evidence: str
+    collision: Literal["hull", "decompose"]
+
 
 @dataclass(frozen=True)
 class ObjectSpec:
@@ -73,6 +106,7 @@ class ObjectSpec:
     mass_source: Citation
     simplification: str
     geometry: Geometry
+    scan: YcbScan
     aliases: tuple[str, ...] = ()
     uncertain: str = ""  #: what could not be sourced or checked, empty when nothing
 

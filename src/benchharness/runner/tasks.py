@@ -1,13 +1,18 @@
 """Turning a task plugin into the list of trials a run executes.
 
 A Rubik's tier ``Rubiks-M-N`` is M trials, trial k with the protocol
-generator's sequence for (seed, tier, k). An in-hand task set is one trial
-per task row (times ``repeats``), in file order. Trial indices are 1-based
+generator's sequence for (seed, tier, k). An in-hand task set of n task rows
+run ``repeats`` = R times is n R trials, numbered repeat-major: trial
+``t + (r - 1) n`` is the r-th repeat of the t-th task row (file order), so
+trials 1..n are one pass over the set whatever R is, trial k always means
+task ``(k - 1) % n + 1``, repeat ``(k - 1) // n + 1``, and ``--trials``
+selects among these numbers (docs/runner.md). Trial indices are 1-based
 and stable, so a stored row always means the same trial.
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,7 +21,7 @@ from ..cube.sequences import generate_sequence
 from ..cube.tiers import RubiksTier
 from .contract import InhandItem, RubiksItem, TrialItem
 
-__all__ = ["TaskPlan", "plan_task", "parse_trial_selection"]
+__all__ = ["TaskPlan", "plan_task", "parse_trial_selection", "trial_task"]
 
 
 @dataclass(frozen=True)
@@ -50,8 +55,8 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
         if repeats < 1:
             raise ValueError("repeats must be at least 1")
         items = {}
-        idx = 1
-        for row in range(len(task.task_id)):
+        n = len(task.task_id)
+        for row in range(n):
             contacts = {
                 stage: np.asarray(c[row], float)
                 for stage, c in (getattr(task, "contacts", None) or {}).items()
@@ -62,7 +67,7 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
                 for k, v in (getattr(task, "extra", None) or {}).items()
             }
             for r in range(1, repeats + 1):
-                items[idx] = InhandItem(
+                items[row + 1 + (r - 1) * n] = InhandItem(
                     task_set=name,
                     task_id=str(task.task_id[row]),
                     object=str(task.object[row]),
@@ -73,8 +78,7 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
                     contacts=contacts,
                     extra=extra,
                 )
-                idx += 1
-        return TaskPlan(name, "inhand", items)
+        return TaskPlan(name, "inhand", dict(sorted(items.items())))
     raise TypeError(
         f"task {name!r} is a {type(task).__name__}; the runner runs Rubik's tiers (RubiksTier) "
         "and in-hand task sets (TaskSet)"
@@ -104,3 +108,37 @@ def parse_trial_selection(text: str | None, available: list[int]) -> list[int]:
             f"--trials: no trial {', '.join(map(str, bad))}; this task has trials 1..{max(available)}"
         )
     return sorted(set(chosen))
+
+
+def trial_task(task: str, index: int, outcome: dict | None = None) -> tuple[str, str, int] | None:
+    """(task id, object, repeat) of in-hand trial ``index`` of task set ``task``; ``None`` otherwise.
+
+    Read from the stored ``outcome`` where the trial was scored, else from
+    the task set itself (a trial that failed before scoring stores no
+    outcome): with the repeat-major numbering, index ``k`` is row
+    ``(k - 1) % n`` whatever the number of repeats. Rubik's tiers, unknown
+    task names and out-of-range indices give ``None``.
+    """
+    o = outcome or {}
+    if o.get("task_id"):
+        return str(o["task_id"]), str(o.get("object", "")), int(o.get("repeat", 1))
+    rows = _inhand_rows(task)
+    if not rows or index < 1:
+        return None
+    tid, obj = rows[(index - 1) % len(rows)]
+    return tid, obj, (index - 1) // len(rows) + 1
+
+
+@functools.lru_cache(maxsize=32)
+def _inhand_rows(task: str) -> tuple[tuple[str, str], ...] | None:
+    if task.startswith("Rubiks-"):
+        return None
+    try:
+        from ..plugin import get_manager
+
+        ts = get_manager().create("task", task)
+    except Exception:  # noqa: BLE001 - a label is best effort: an unloadable task just has none
+        return None
+    if not all(hasattr(ts, a) for a in ("task_id", "object")):
+        return None
+    return tuple((str(t), str(o)) for t, o in zip(ts.task_id, ts.object))

@@ -73,7 +73,9 @@ def rest_pose(obj: str, grasp_axis, pivot: float = 0.0) -> Pose:
     from .config import MotionConfig
     from .rig import clearance, stable_rest_poses
 
-    model = load_object(obj)
+    model = load_object(
+        obj, model="generated"
+    )  # the pivoting tasks are defined on the generated frames
     rests = stable_rest_poses(model.surface, model.mass.com, grasp_axis)
     width = float(
         np.ptp(
@@ -95,7 +97,9 @@ def initial_grasp(obj: str, grasp_axis, pivot: float, rest: Pose | None = None) 
     """Hand pose (object frame) of the initial grasp for a pivot of ``pivot`` rad (see module docstring)."""
     from ...objects import load_object
 
-    model = load_object(obj)
+    model = load_object(
+        obj, model="generated"
+    )  # the pivoting tasks are defined on the generated frames
     a = np.asarray(grasp_axis, float) / np.linalg.norm(grasp_axis)
     rest = rest_pose(obj, a, pivot) if rest is None else rest
     verts = rest.apply(np.asarray(model.surface.vertices))
