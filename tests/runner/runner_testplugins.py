@@ -149,6 +149,17 @@ class StuckStrategy:
         time.sleep(60)
 
 
+class SegfaultStrategy:
+    """Kills its own process as an engine crash would (trial 2 only; the others succeed)."""
+
+    def run_trial(self, ctx):
+        import signal
+
+        if ctx.trial_index == 2:
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return TimedStrategy().run_trial(ctx)
+
+
 class ExitStrategy:
     """Calls sys.exit mid-trial (a library's error path, a stray ``exit()``)."""
 
@@ -202,6 +213,7 @@ STRATEGIES = {
     "test-hang": HangStrategy,
     "test-stuck": StuckStrategy,
     "test-exit": ExitStrategy,
+    "test-segfault": SegfaultStrategy,
     "test-interrupt": InterruptStrategy,
     "test-jammed": JammedStrategy,
     "test-notoutcome": NotAnOutcomeStrategy,

@@ -174,6 +174,17 @@ def test_sigterm_and_ctrl_c_stop_in_flight_trials_and_keep_finished_ones(
         assert store.claims() == []  # nothing is left claimed: a re-run takes trials 3-5 at once
 
 
+def test_sigterm_stops_an_in_process_sweep_too(launch, store_path):
+    r = launch(store_path, workers=0, RUNNER_TEST_HANG_FROM="3")
+    assert _wait(lambda: _count(store_path) >= 2, 60)
+    time.sleep(0.5)
+    r.proc.send_signal(signal.SIGTERM)
+    out, err = r.proc.communicate(timeout=30)
+    assert r.proc.returncode == 143, err
+    with ResultsStore(store_path, read_only=True) as store:
+        assert [t.trial_index for t in store.trials()] == [1, 2] and store.claims() == []
+
+
 @linux_only
 def test_ctrl_c_in_a_terminal_reaches_the_whole_group(launch, store_path):
     r = launch(store_path, RUNNER_TEST_HANG_FROM="3")
@@ -230,6 +241,18 @@ def test_a_strategy_that_exits_fails_its_trial_only(make_spec, store_path, strat
 def test_system_exit_is_contained_in_process_too(make_spec):
     rec = execute_trial(make_spec("test-exit"), 1)
     assert rec.failure_cause is FailureCause.STRATEGY_ERROR and "SystemExit: 3" in rec.message
+
+
+def test_a_trial_that_kills_its_worker_twice_is_a_simulator_error(make_spec, store_path):
+    spec = make_spec("test-segfault")
+    with ResultsStore(store_path) as store:
+        report = run_sweep(spec, store, workers=2)
+        rows = {t.trial_index: t for t in store.trials(run_key=spec.run_key)}
+    assert report.ran == 5 and sorted(rows) == [1, 2, 3, 4, 5]
+    assert rows[2].failure_cause is FailureCause.SIMULATOR_ERROR
+    assert "died while running this trial, twice" in rows[2].message
+    assert f"exit code {-signal.SIGSEGV}" in rows[2].message
+    assert all(rows[i].status is TrialStatus.SUCCESS for i in (1, 3, 4, 5))
 
 
 # -- 5: two runs of the same command at once --------------------------------------------------

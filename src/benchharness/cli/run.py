@@ -277,12 +277,14 @@ def _sweep(spec, store, workers, trial_sel, retry_failed, progress, video=None):
     except (PluginNotFoundError, ValueError, TypeError) as exc:
         fail(str(exc))
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: finished trials are stored
+        import signal
+
         bar.stop()
         n = store.count(spec.run_key)
-        signum = getattr(exc, "signum", 2)
+        signum = getattr(exc, "signum", signal.SIGINT)
         fail(
-            f"interrupted ({getattr(exc, 'args', ('SIGINT',))[0] or 'SIGINT'}); {n} trial(s) of "
-            f"run {spec.run_key} are in {store.path}. Re-run the same command to resume.",
+            f"interrupted ({signal.Signals(signum).name}); {n} trial(s) of run {spec.run_key} "
+            f"are in {store.path}. Re-run the same command to resume.",
             128 + signum,
         )
     finally:
