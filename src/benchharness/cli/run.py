@@ -126,7 +126,8 @@ def run_options(f: Callable) -> Callable:
             "--wall-budget",
             type=float,
             default=None,
-            help="Wall-clock seconds per trial (default none: results then never depend on machine speed).",
+            help="Wall-clock seconds per trial (default none, so results never depend on machine "
+            "speed; a stuck trial is still ended after max(600 s, 10 x the simulated budget)).",
         ),
         click.option(
             "--plugin",

@@ -232,9 +232,10 @@ def _inspect(path: Path, *, read_only: bool) -> _Inspection:
     except sqlite3.Error as exc:
         raise StoreError(f"{path}: cannot open it read-only ({exc})") from None
     try:
+        names = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")]
         tables = {
-            r[0]: [c[1] for c in con.execute(f"PRAGMA table_info({r[0]})")]
-            for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")
+            n: [c[1] for c in con.execute('PRAGMA table_info("{}")'.format(n.replace('"', '""')))]
+            for n in names
         }
         if not tables and app_id == 0:
             if read_only:
