@@ -232,10 +232,10 @@ def _inspect(path: Path, *, read_only: bool) -> _Inspection:
     except sqlite3.Error as exc:
         raise StoreError(f"{path}: cannot open it read-only ({exc})") from None
     try:
-        names = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")]
+        found = [r[0] for r in con.execute("SELECT name FROM sqlite_master WHERE type = 'table'")]
         tables = {
             n: [c[1] for c in con.execute('PRAGMA table_info("{}")'.format(n.replace('"', '""')))]
-            for n in names
+            for n in found
         }
         if not tables and app_id == 0:
             if read_only:
