@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 
 from benchharness.runner import FailureCause, ResultsStore, TimeBudget, TrialStatus, run_sweep
+from benchharness.runner.store import StoreError
 from benchharness.runner.trial import execute_trial
 
 HERE = Path(__file__).resolve().parent  # holds runner_testplugins.py
@@ -206,7 +207,7 @@ def test_the_parent_ends_a_stuck_trial_at_the_wall_budget(make_spec, store_path)
     with ResultsStore(store_path) as store:
         report = run_sweep(spec, store, workers=1)
         (row,) = store.trials(run_key=spec.run_key)
-    assert time.monotonic() - t0 < 20  # the strategy sleeps 60 s with the alarm blocked
+    assert time.monotonic() - t0 < 30  # the strategy sleeps 60 s with the alarm blocked
     assert report.ran == 1
     assert row.failure_cause is FailureCause.TIMEOUT
     assert "wall-time budget of 0.5 s" in row.message and "ended" in row.message
@@ -260,10 +261,18 @@ def test_a_trial_that_kills_its_worker_twice_is_a_simulator_error(make_spec, sto
 
 def test_two_concurrent_runs_share_the_trials(launch, store_path, tmp_path):
     log = tmp_path / "executions.log"
-    runs = [
-        launch(store_path, workers=1, RUNNER_TEST_SLEEP="0.4", RUNNER_TEST_LOG=str(log))
-        for _ in range(2)
-    ]
+    env = dict(RUNNER_TEST_SLEEP="2", RUNNER_TEST_LOG=str(log))  # ~10 s for one run alone
+    first = launch(store_path, workers=1, **env)
+
+    def claimed() -> bool:
+        try:
+            with ResultsStore(store_path, read_only=True) as store:
+                return bool(store.claims())
+        except (StoreError, sqlite3.Error):  # not created yet
+            return False
+
+    assert _wait(claimed, 60)  # the first run is under way: the second starts mid-run
+    runs = [first, launch(store_path, workers=1, **env)]
     outs = []
     for r in runs:
         out, err = r.proc.communicate(timeout=120)
