@@ -37,7 +37,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from multiprocessing.connection import Connection, wait
+from multiprocessing.connection import wait
 from typing import Any, Literal
 
 from .causes import FailureCause, TrialStatus
@@ -49,6 +49,7 @@ from .store import ClaimOwner, ResultsStore
 from .tasks import TaskPlan, parse_trial_selection
 from .trial import execute_trial, plan_for
 from .video import VideoSpec
+from .workers import Worker
 
 __all__ = [
     "SweepInterrupted",
@@ -263,91 +264,6 @@ class _Claims:
         self.queue.insert(0, i)  # still ours: the claim is re-taken at once
 
 
-# -- workers ---------------------------------------------------------------------------------------
-
-
-def _die_with_parent(lifeline: Connection) -> None:
-    """End this worker when the parent dies (SIGKILL included), however the trial is stuck."""
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            PR_SET_PDEATHSIG = 1
-            libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-        except (OSError, AttributeError):
-            pass
-
-    def watch() -> None:
-        try:
-            lifeline.recv()  # the parent never sends: this returns only at end-of-file
-        except (EOFError, OSError):
-            pass
-        os._exit(70)
-
-    threading.Thread(target=watch, name="benchharness-lifeline", daemon=True).start()
-
-
-def _worker_main(conn: Connection, lifeline: Connection, parent: int) -> None:
-    """A sweep worker: receive (spec, index, video), send ("started", i) then ("done", record)."""
-    _die_with_parent(lifeline)
-    if os.getppid() != parent:  # the parent died before the death signal was armed
-        os._exit(70)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        sys.stdout.flush()
-        os.dup2(2, 1)  # engine banners: see _quiet_stdout
-    except OSError:
-        pass
-    while True:
-        try:
-            job = conn.recv()
-        except EOFError:
-            return
-        if job is None:
-            return
-        spec, index, video = job
-        conn.send(("started", index))
-        rec = execute_trial(spec, index, video, contain_interrupts=True)
-        conn.send(("done", rec))
-
-
-class _Worker:
-    def __init__(self, ctx: Any) -> None:
-        self.conn, child = ctx.Pipe()
-        lifeline_r, self.lifeline = ctx.Pipe(duplex=False)
-        self.proc = ctx.Process(
-            target=_worker_main, args=(child, lifeline_r, os.getpid()), daemon=True
-        )
-        self.proc.start()
-        child.close()
-        lifeline_r.close()
-        self.index: int | None = None
-        self.sent = 0.0
-        self.started: float | None = None
-
-    def give(self, job: tuple[RunSpec, int, VideoSpec | None]) -> None:
-        self.index = job[1]
-        self.sent, self.started = time.monotonic(), None
-        self.conn.send(job)
-
-    def stop(self, kill: bool = False) -> None:
-        if self.proc.is_alive():
-            if kill:
-                self.proc.kill()
-            else:
-                try:
-                    self.conn.send(None)
-                except OSError:
-                    self.proc.kill()
-        self.proc.join(5)
-        if self.proc.is_alive():
-            self.proc.kill()
-            self.proc.join(5)
-        for c in (self.conn, self.lifeline):
-            c.close()
-
-
 def _run_in_workers(
     ctx: Any,
     workers: int,
@@ -358,7 +274,7 @@ def _run_in_workers(
     signals: _Signals,
 ) -> None:
     limit = watchdog_limit(spec.budget)
-    pool: list[_Worker] = []
+    pool: list[Worker] = []
     crashed: set[int] = set()
     try:
         while True:
@@ -369,7 +285,7 @@ def _run_in_workers(
                 if w.index is None and (i := claims.next()) is not None:
                     w.give((spec, i, video))
             while len(pool) < workers and (i := claims.next()) is not None:
-                pool.append(_Worker(ctx))
+                pool.append(Worker(ctx))
                 pool[-1].give((spec, i, video))
             running = [w for w in pool if w.index is not None]
             if not running:
