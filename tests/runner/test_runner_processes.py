@@ -213,6 +213,21 @@ def test_the_parent_ends_a_stuck_trial_at_the_wall_budget(make_spec, store_path)
     assert "wall-time budget of 0.5 s" in row.message and "ended" in row.message
 
 
+def test_without_a_wall_budget_the_backstop_ends_a_stuck_trial(make_spec, store_path, monkeypatch):
+    from benchharness.runner import sweep
+
+    # the real backstop is max(600 s, 10 × sim budget); scaled down here so the test takes seconds
+    monkeypatch.setattr(sweep, "BACKSTOP_MIN_S", 0.0)
+    monkeypatch.setattr(sweep, "BACKSTOP_FACTOR", 0.5)
+    spec = make_spec("test-stuck", task="Rubiks-1-5", budget=TimeBudget(sim_s=2.0))
+    assert sweep.watchdog_limit(spec.budget) == pytest.approx(1.0)
+    with ResultsStore(store_path) as store:
+        run_sweep(spec, store, workers=1)
+        (row,) = store.trials(run_key=spec.run_key)
+    assert row.failure_cause is FailureCause.TIMEOUT
+    assert "no wall-time budget set; the backstop of 1 s" in row.message
+
+
 def test_default_wall_backstop_is_derived_from_the_simulated_budget():
     from benchharness.runner.sweep import watchdog_limit
 

@@ -346,7 +346,8 @@ def _run_in_workers(
                         f"wall-time budget of {budget:g} s spent"
                         if budget is not None
                         else f"no wall-time budget set; the backstop of {limit:g} s "
-                        f"({BACKSTOP_FACTOR:g} × the simulated budget) passed"
+                        f"(max({BACKSTOP_MIN_S:g} s, {BACKSTOP_FACTOR:g} × the simulated budget)) "
+                        "passed"
                     )
                     with signals.critical():
                         finish(
