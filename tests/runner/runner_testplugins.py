@@ -67,6 +67,13 @@ class DropStrategy:
         final = expected_final(moves, ctx.item.initial)
         if os.environ.get("RUNNER_TEST_SLEEP"):
             time.sleep(float(os.environ["RUNNER_TEST_SLEEP"]))
+        if os.environ.get("RUNNER_TEST_HANG_FROM") and ctx.trial_index >= int(
+            os.environ["RUNNER_TEST_HANG_FROM"]
+        ):
+            time.sleep(120)  # a long trial still in flight when the test stops the run
+        if os.environ.get("RUNNER_TEST_LOG"):  # who ran which trial: one line per execution
+            with open(os.environ["RUNNER_TEST_LOG"], "a") as f:
+                f.write(f"{os.getpid()} {ctx.trial_index}\n")
         return TrialOutcome(final_state=final)
 
 
@@ -132,6 +139,43 @@ class HangStrategy:
         time.sleep(60)
 
 
+class StuckStrategy:
+    """Stuck where no Python signal handler runs (as in native code): the wall alarm is blocked."""
+
+    def run_trial(self, ctx):
+        import signal
+
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGALRM})
+        time.sleep(60)
+
+
+class SegfaultStrategy:
+    """Kills its own process as an engine crash would (trial 2 only; the others succeed)."""
+
+    def run_trial(self, ctx):
+        import signal
+
+        if ctx.trial_index == 2:
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return TimedStrategy().run_trial(ctx)
+
+
+class ExitStrategy:
+    """Calls sys.exit mid-trial (a library's error path, a stray ``exit()``)."""
+
+    def run_trial(self, ctx):
+        ctx.backend.add_ground()
+        ctx.backend.step(3)
+        raise SystemExit(3)
+
+
+class InterruptStrategy:
+    """Raises KeyboardInterrupt itself (no Ctrl-C was pressed)."""
+
+    def run_trial(self, ctx):
+        raise KeyboardInterrupt("raised by the strategy (test)")
+
+
 class JammedStrategy:
     def run_trial(self, ctx):
         ctx.backend.add_ground()
@@ -167,6 +211,10 @@ STRATEGIES = {
     "test-crash": CrashStrategy,
     "test-slowsim": SlowSimStrategy,
     "test-hang": HangStrategy,
+    "test-stuck": StuckStrategy,
+    "test-exit": ExitStrategy,
+    "test-segfault": SegfaultStrategy,
+    "test-interrupt": InterruptStrategy,
     "test-jammed": JammedStrategy,
     "test-notoutcome": NotAnOutcomeStrategy,
     "test-inhand": InhandNoisyStrategy,

@@ -245,7 +245,10 @@ def test_inhand_figure7_plot_and_compare_summary(invoke, tmp_path):
     )
 
 
-def test_table_plot_without_inhand_trials_is_a_clear_error(invoke, tmp_path):
+def test_table_plot_without_inhand_trials_is_a_clear_error(invoke, tmp_path, store_path):
+    from benchharness.runner.store import ResultsStore
+
+    ResultsStore(store_path).close()  # a store with no trials (reading never creates one)
     r = invoke(table, "--plot", str(tmp_path / "f.png"))
     assert r.exit_code == 2 and "no in-hand trials" in r.output
 

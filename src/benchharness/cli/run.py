@@ -62,11 +62,12 @@ def store_option(f: Callable) -> Callable:
     )(f)
 
 
-def _open_store(path: Path | None):
+def _open_store(path: Path | None, read_only: bool = False):
+    """The store (exit 2 naming the path if it is not one); ``read_only`` for commands that read."""
     from ..runner.store import ResultsStore, StoreError
 
     try:
-        return ResultsStore(path)
+        return ResultsStore(path, read_only=read_only)
     except StoreError as exc:
         fail(str(exc))
 
@@ -125,7 +126,8 @@ def run_options(f: Callable) -> Callable:
             "--wall-budget",
             type=float,
             default=None,
-            help="Wall-clock seconds per trial (default none: results then never depend on machine speed).",
+            help="Wall-clock seconds per trial (default none, so results never depend on machine "
+            "speed; a stuck trial is still ended after max(600 s, 10 x the simulated budget)).",
         ),
         click.option(
             "--plugin",
@@ -276,13 +278,16 @@ def _sweep(spec, store, workers, trial_sel, retry_failed, progress, video=None):
         )
     except (PluginNotFoundError, ValueError, TypeError) as exc:
         fail(str(exc))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: finished trials are stored
+        import signal
+
         bar.stop()
         n = store.count(spec.run_key)
+        signum = getattr(exc, "signum", signal.SIGINT)
         fail(
-            f"interrupted; {n} trial(s) of run {spec.run_key} are in {store.path}. "
-            "Re-run the same command to resume.",
-            130,
+            f"interrupted ({signal.Signals(signum).name}); {n} trial(s) of run {spec.run_key} "
+            f"are in {store.path}. Re-run the same command to resume.",
+            128 + signum,
         )
     finally:
         bar.stop()
@@ -481,6 +486,7 @@ def run(
                     "selected": report.selected,
                     "ran": report.ran,
                     "skipped": report.skipped,
+                    "by_other_runs": sorted(report.by_others),
                     "failures": sum(r.status.value == "failure" for r in rows),
                     "elapsed_s": elapsed,
                     "tier": None if cell is None else cell.to_dict(),
@@ -501,6 +507,11 @@ def run(
             console.print(
                 f"run {spec.run_key} in {store.path}: ran {report.ran}, skipped {len(report.skipped)} "
                 f"already stored, {elapsed:.1f} s"
+                + (
+                    f"; {len(report.by_others)} run by another process of the same command"
+                    if report.by_others
+                    else ""
+                )
             )
             if cell is not None:
                 from ..runner.reports import format_cell
@@ -576,7 +587,7 @@ def table(
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         fail(f"--plot: {plot_path} must end in .png or .svg")
 
-    with _open_store(store_path) as store:
+    with _open_store(store_path, read_only=True) as store:
         filters = dict(
             strategy=list(strategies) or None,
             backend=list(backends) or None,
@@ -912,7 +923,7 @@ def results(
       benchharness results --failures --traceback
       benchharness results --task Rubiks-1-50 --plot-pose-error drift.png
     """
-    with _open_store(store_path) as store:
+    with _open_store(store_path, read_only=True) as store:
         rows = store.trials(
             failures_only=failures,
             task=list(tasks) or None,

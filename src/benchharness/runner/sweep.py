@@ -1,41 +1,101 @@
-"""Sweeps: the trials of a run, in a process pool, written by the parent as they finish.
+"""Sweeps: the trials of a run, in worker processes, written by the parent as they finish.
 
 * Resume: trials already in the store under the same run key are skipped,
   so re-running the same command after a kill carries on where it stopped.
+* Sharing: a trial is claimed in the store before it runs
+  (:meth:`ResultsStore.claim`, a lease renewed while this sweep lives), so two
+  sweeps of the same run split the trials; when its own are done a sweep waits
+  for the ones another live sweep is running, and takes over any whose owner
+  died (at once on this host, when the lease lapses from another).
 * Workers are *spawned* (not forked): a fresh interpreter per worker, no
   inherited engine state or locks. Each trial builds its own world, so
   results depend only on (run, trial index), not on the worker count.
-* At most ``workers`` trials are in flight. If a worker process dies (an
-  engine segfault), the trials it may have been running are retried once in a
-  fresh pool; a trial that kills its worker twice is recorded as
-  ``simulator_error``. Nothing that happens in a trial ends the sweep.
+* Workers die with the parent: ``PR_SET_PDEATHSIG`` on Linux, and on every
+  platform a lifeline pipe whose end only the parent holds (a worker thread
+  exits the process when it reads end-of-file). They ignore SIGINT: the
+  parent owns interruption. On Ctrl-C or SIGTERM the parent stores every
+  result already sent, ends the workers (in-flight trials are not stored and
+  run again on resume), releases its claims and raises
+  :class:`SweepInterrupted`.
+* Watchdog: the parent ends a worker whose trial outlives
+  :func:`watchdog_limit` (a trial stuck in native code, where neither the
+  per-step check nor the alarm can reach it) and stores a ``timeout``.
+* If a worker process dies (an engine segfault) the trial it was running is
+  retried once in a fresh worker; a trial that kills its worker twice is
+  recorded as ``simulator_error``. Nothing that happens in a trial ends the
+  sweep.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from multiprocessing.connection import wait
+from typing import Any, Literal
 
 from .causes import FailureCause, TrialStatus
+from .contract import TimeBudget
 from .plugins import lookup
 from .records import TrialRecord
 from .spec import RunSpec
-from .store import ResultsStore
+from .store import ClaimOwner, ResultsStore
 from .tasks import TaskPlan, parse_trial_selection
 from .trial import execute_trial, plan_for
 from .video import VideoSpec
+from .workers import Worker
 
-__all__ = ["SweepReport", "default_workers", "prepare", "run_sweep"]
+__all__ = [
+    "SweepInterrupted",
+    "SweepReport",
+    "default_workers",
+    "prepare",
+    "run_sweep",
+    "watchdog_limit",
+]
+
+#: Claims last this long unless renewed (every quarter of it): how long another
+#: machine waits before taking over the trials of a sweep that died.
+LEASE_S = 120.0
+#: With no ``--wall-budget``, the parent's backstop is this many times the
+#: simulated budget (at least :data:`BACKSTOP_MIN_S`): trials run at 3-10
+#: simulated seconds per wall second here, so only a stuck trial reaches it.
+BACKSTOP_FACTOR = 10.0
+BACKSTOP_MIN_S = 600.0
 
 
 def default_workers() -> int:
     """Half the cores (physics is CPU-bound and the parent needs some), at least 1."""
     return max(1, (os.cpu_count() or 2) // 2)
+
+
+def watchdog_limit(budget: TimeBudget) -> float | None:
+    """Wall seconds after which the parent ends a trial's worker (None: never).
+
+    An explicit wall budget: after the in-trial alarm (1.1 × budget + 1 s) has
+    had 5 s (and a tenth of the budget) to speak. Otherwise a backstop derived
+    from the simulated budget, max(600 s, 10 × sim budget); it is not part of
+    the run key, since it stops only trials that would otherwise never end.
+    """
+    if budget.wall_s is not None:
+        return budget.wall_s * 1.1 + 1.0 + max(5.0, 0.1 * budget.wall_s)
+    if budget.sim_s is not None:
+        return max(BACKSTOP_MIN_S, BACKSTOP_FACTOR * budget.sim_s)
+    return None
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) or SIGTERM during a sweep; finished trials are stored."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
 
 
 @dataclass
@@ -45,6 +105,10 @@ class SweepReport:
     selected: list[int]
     skipped: list[int] = field(default_factory=list)
     records: list[TrialRecord] = field(default_factory=list)
+    #: Trials stored by another sweep of the same run while this one ran.
+    by_others: list[int] = field(default_factory=list)
+    #: Trials another live sweep was still running when this one stopped waiting.
+    busy: list[int] = field(default_factory=list)
 
     @property
     def ran(self) -> int:
@@ -71,27 +135,13 @@ def prepare(spec: RunSpec) -> TaskPlan:
     return plan
 
 
-def _stdout_to_stderr() -> None:
-    """Point file descriptor 1 at stderr for the rest of this process.
-
-    Engines print banners from C at import (PyBullet's "build time" line);
-    in a sweep stdout belongs to the parent's report (``--json``), so worker
-    processes send anything written to stdout to stderr instead.
-    """
-    import sys
-
-    try:
-        sys.stdout.flush()
-        os.dup2(2, 1)
-    except OSError:
-        pass
-
-
 @contextmanager
 def _quiet_stdout() -> Iterator[None]:
-    """:func:`_stdout_to_stderr` for the duration of an in-process (``workers=0``) sweep."""
-    import sys
+    """Stdout to stderr for the duration of an in-process (``workers=0``) trial.
 
+    Engines print banners from C at import (PyBullet's "build time" line); in a
+    sweep stdout belongs to the parent's report (``--json``).
+    """
     try:
         sys.stdout.flush()
         saved = os.dup(1)
@@ -110,19 +160,221 @@ def _quiet_stdout() -> Iterator[None]:
         os.close(saved)
 
 
-def _crash_record(spec: RunSpec, index: int, detail: str) -> TrialRecord:
+def _failure_record(spec: RunSpec, index: int, cause: FailureCause, message: str, wall: float):
     return TrialRecord(
-        spec.run_key,
-        index,
-        TrialStatus.FAILURE,
-        None,
-        FailureCause.SIMULATOR_ERROR,
-        f"the worker process died while running this trial, twice ({detail})",
-        0.0,
-        None,
-        None,
-        None,
+        spec.run_key, index, TrialStatus.FAILURE, None, cause, message, wall, None, None, None
     )
+
+
+# -- signals -------------------------------------------------------------------------------------
+
+
+class _Signals:
+    """SIGINT and SIGTERM raise :class:`SweepInterrupted`, except inside :meth:`critical`
+    (storing a result), where they are held until it ends."""
+
+    def __init__(self) -> None:
+        self._depth = 0
+        self._held: int | None = None
+        self._old: dict[int, Any] = {}
+
+    def __enter__(self) -> _Signals:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self._depth:
+            self._held = signum
+            return
+        raise SweepInterrupted(signum)
+
+    @contextmanager
+    def critical(self) -> Iterator[None]:
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+        if not self._depth and self._held is not None:
+            signum, self._held = self._held, None
+            raise SweepInterrupted(signum)
+
+
+# -- which trial next ------------------------------------------------------------------------------
+
+
+class _Claims:
+    """The trials this sweep still has to see stored, claimed one at a time as workers free up."""
+
+    def __init__(
+        self,
+        store: ResultsStore,
+        spec: RunSpec,
+        pending: list[int],
+        report: SweepReport,
+        *,
+        retry_failed: bool,
+        forced: set[int],
+        wait_for_others: bool,
+    ) -> None:
+        self.store, self.spec, self.report = store, spec, report
+        self.queue = list(pending)
+        self.busy: list[int] = []
+        self.retry_failed, self.forced = retry_failed, forced
+        self.wait_for_others = wait_for_others
+        self.owner = ClaimOwner.new()
+        self.since = time.time()
+        self._next_look = 0.0
+
+    def next(self) -> int | None:
+        """The next trial claimed for this sweep, or None if none is claimable now."""
+        if self.busy and not self.queue and time.monotonic() >= self._next_look:
+            self.queue, self.busy = self.busy, []  # look again at the other sweeps' trials
+            self._next_look = time.monotonic() + 1.0
+        while self.queue:
+            i = self.queue.pop(0)
+            redo: Literal["failed", "any"] | None = (
+                "any" if i in self.forced else ("failed" if self.retry_failed else None)
+            )
+            got = self.store.claim(
+                self.spec.run_key, i, self.owner, lease_s=LEASE_S, redo=redo, since=self.since
+            )
+            if got == "claimed":
+                return i
+            if got == "busy":
+                self.busy.append(i)
+            else:
+                self.report.by_others.append(i)
+        return None
+
+    def waiting(self) -> bool:
+        """True while trials are left that another live sweep runs (and we wait for them)."""
+        if self.busy and not self.wait_for_others:
+            self.report.busy = sorted(self.busy)
+            return False
+        return bool(self.busy or self.queue)
+
+    def requeue(self, i: int) -> None:
+        self.queue.insert(0, i)  # still ours: the claim is re-taken at once
+
+
+def _run_in_workers(
+    ctx: Any,
+    workers: int,
+    claims: _Claims,
+    spec: RunSpec,
+    video: VideoSpec | None,
+    finish: Callable[[TrialRecord], None],
+    signals: _Signals,
+) -> None:
+    limit = watchdog_limit(spec.budget)
+    pool: list[Worker] = []
+    crashed: set[int] = set()
+    try:
+        while True:
+            for w in [w for w in pool if w.index is None and not w.proc.is_alive()]:
+                w.stop()  # an idle worker that died: replaced below if there is work
+                pool.remove(w)
+            for w in pool:
+                if w.index is None and (i := claims.next()) is not None:
+                    w.give((spec, i, video))
+            while len(pool) < workers and (i := claims.next()) is not None:
+                pool.append(Worker(ctx))
+                pool[-1].give((spec, i, video))
+            running = [w for w in pool if w.index is not None]
+            if not running:
+                if not claims.waiting():
+                    return
+                time.sleep(0.5)
+                continue
+            now = time.monotonic()
+            deadlines = [
+                (w.started if w.started is not None else w.sent + 60.0) + limit
+                for w in running
+                if limit is not None
+            ]
+            timeout = max(0.0, min([*deadlines, now + 1.0]) - now)
+            ready = wait([w.conn for w in running] + [w.proc.sentinel for w in running], timeout)
+            for w in running:
+                while w.index is not None and w.conn in ready and w.conn.poll():
+                    try:
+                        msg = w.conn.recv()
+                    except (EOFError, OSError):
+                        break
+                    if msg[0] == "started":
+                        w.started = time.monotonic()
+                    else:
+                        w.index = None
+                        with signals.critical():
+                            finish(msg[1])
+                if w.index is not None and not w.proc.is_alive():  # died mid-trial
+                    i, w.index = w.index, None
+                    w.stop(kill=True)
+                    pool.remove(w)
+                    if i in crashed:
+                        detail = f"exit code {w.proc.exitcode}"
+                        with signals.critical():
+                            finish(
+                                _failure_record(
+                                    spec,
+                                    i,
+                                    FailureCause.SIMULATOR_ERROR,
+                                    f"the worker process died while running this trial, twice ({detail})",
+                                    time.monotonic() - w.sent,
+                                )
+                            )
+                    else:
+                        crashed.add(i)
+                        claims.requeue(i)
+            if limit is None:
+                continue
+            now = time.monotonic()
+            for w in list(pool):
+                t0 = w.started if w.started is not None else w.sent + 60.0  # 60 s to start up
+                if w.index is not None and now - t0 > limit:
+                    i, w.index = w.index, None
+                    w.stop(kill=True)
+                    pool.remove(w)
+                    budget = spec.budget.wall_s
+                    why = (
+                        f"wall-time budget of {budget:g} s spent"
+                        if budget is not None
+                        else f"no wall-time budget set; the backstop of {limit:g} s "
+                        f"(max({BACKSTOP_MIN_S:g} s, {BACKSTOP_FACTOR:g} × the simulated budget)) "
+                        "passed"
+                    )
+                    with signals.critical():
+                        finish(
+                            _failure_record(
+                                spec,
+                                i,
+                                FailureCause.TIMEOUT,
+                                f"{why} and the trial did not stop (stuck outside Python?); "
+                                f"the parent ended its worker process after {now - t0:.1f} s",
+                                now - t0,
+                            )
+                        )
+    except KeyboardInterrupt:
+        # Store what already finished (results sent but not yet read); stop the rest.
+        for w in pool:
+            try:
+                while w.index is not None and w.conn.poll():
+                    msg = w.conn.recv()
+                    if msg[0] == "done":
+                        w.index = None
+                        finish(msg[1])
+            except (EOFError, OSError):
+                pass
+        raise
+    finally:
+        for w in pool:
+            w.stop(kill=w.index is not None)
 
 
 def run_sweep(
@@ -135,89 +387,58 @@ def run_sweep(
     video: VideoSpec | None = None,
     on_start: Callable[[SweepReport, int], None] | None = None,
     on_record: Callable[[TrialRecord], None] | None = None,
+    wait_for_others: bool = True,
 ) -> SweepReport:
-    """Run the pending trials of ``spec``; ``workers=0`` runs them in this process (debugging)."""
+    """Run the pending trials of ``spec``; ``workers=0`` runs them in this process (debugging).
+
+    ``workers=0`` has no watchdog (nothing outside the trial could end it):
+    only the per-step budget check and the wall alarm apply. Raises
+    :class:`SweepInterrupted` on Ctrl-C/SIGTERM once finished trials are stored.
+    """
     plan = prepare(spec)
     selected = parse_trial_selection(trials, sorted(plan.items))
+    if video is not None and video.trial_index not in plan.items:
+        raise ValueError(f"--video-trial {video.trial_index}: this task has trials 1..{plan.total}")
     store.ensure_run(spec, plan.benchmark, plan.total)
     done = store.finished(spec.run_key, retry_failed=retry_failed)
     forced = {video.trial_index} if video is not None else set()
-    if video is not None and video.trial_index not in plan.items:
-        raise ValueError(f"--video-trial {video.trial_index}: this task has trials 1..{plan.total}")
     pending = [i for i in selected if i not in done or i in forced]
     report = SweepReport(
         spec, plan, selected, skipped=[i for i in selected if i in done and i not in forced]
     )
     if on_start is not None:
         on_start(report, len(pending))
+    claims = _Claims(
+        store,
+        spec,
+        pending,
+        report,
+        retry_failed=retry_failed,
+        forced=forced,
+        wait_for_others=wait_for_others,
+    )
 
     def finish(rec: TrialRecord) -> None:
-        store.write(rec)
+        if not store.write(rec, claims.owner):
+            report.by_others.append(rec.trial_index)  # our lease lapsed; the taker stores it
+            return
         report.records.append(rec)
         if on_record is not None:
             on_record(rec)
 
-    if workers <= 0:
-        for i in pending:
+    with _Signals() as signals, store.keep_claims(claims.owner, LEASE_S):
+        if workers > 0:
+            ctx = multiprocessing.get_context("spawn")
+            _run_in_workers(ctx, workers, claims, spec, video, finish, signals)
+            return report
+        while True:
+            i = claims.next()
+            if i is None:
+                if not claims.waiting():
+                    return report
+                time.sleep(0.5)
+                continue
             with _quiet_stdout():
                 rec = execute_trial(spec, i, video)
-            finish(rec)
-        return report
-
-    ctx = multiprocessing.get_context("spawn")
-    queue = list(pending)
-    suspects: list[int] = []
-    while queue:
-        broken = _drain(ctx, workers, queue, suspects, spec, video, finish)
-        if not broken:
-            break
-    # Trials that were in flight when a worker died: once more, each alone, to find the culprit.
-    for i in sorted(suspects):
-        alone: list[int] = [i]
-        again: list[int] = []
-        if _drain(ctx, 1, alone, again, spec, video, finish):
-            finish(_crash_record(spec, i, "BrokenProcessPool"))
-    return report
-
-
-def _drain(
-    ctx,
-    workers: int,
-    queue: list[int],
-    suspects: list[int],
-    spec: RunSpec,
-    video: VideoSpec | None,
-    finish: Callable[[TrialRecord], None],
-) -> bool:
-    """Run ``queue`` in one pool until empty or the pool breaks (then True; the
-    in-flight trials are moved to ``suspects``)."""
-    pool = ProcessPoolExecutor(
-        max_workers=max(1, min(workers, len(queue))), mp_context=ctx, initializer=_stdout_to_stderr
-    )
-    inflight: dict[Future, int] = {}
-    try:
-        while queue or inflight:
-            while queue and len(inflight) < workers:
-                i = queue.pop(0)
-                inflight[pool.submit(execute_trial, spec, i, video)] = i
-            finished, _ = wait(inflight, return_when=FIRST_COMPLETED)
-            broke = False
-            for fut in finished:
-                i = inflight.pop(fut)
-                try:
-                    rec = fut.result()
-                except BrokenProcessPool:
-                    suspects.append(i)
-                    broke = True
-                    continue
+            with signals.critical():
                 finish(rec)
-            if broke:
-                suspects.extend(inflight.values())
-                inflight.clear()
-                pool.shutdown(wait=False, cancel_futures=True)
-                return True
-    except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown(wait=True)
-    return False

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import Any, Protocol, cast
 
 import numpy as np
 
@@ -37,6 +38,16 @@ class TaskPlan:
         return len(self.items)
 
 
+class _TaskSetLike(Protocol):
+    """What the runner reads of an in-hand task set (``benchharness.inhand.records.TaskSet``)."""
+
+    task_id: Any
+    object: Any
+    level: Any
+    initial: Any
+    desired: Any
+
+
 def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
     if isinstance(task, RubiksTier):
         items: dict[int, TrialItem] = {
@@ -52,10 +63,11 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
         return TaskPlan(task.name, "rubiks", items)
     # In-hand task sets: duck-typed on benchharness.inhand.records.TaskSet.
     if all(hasattr(task, a) for a in ("task_id", "initial", "desired", "object", "level")):
+        ts = cast(_TaskSetLike, task)
         if repeats < 1:
             raise ValueError("repeats must be at least 1")
         items = {}
-        n = len(task.task_id)
+        n = len(ts.task_id)
         for row in range(n):
             contacts = {
                 stage: np.asarray(c[row], float)
@@ -69,11 +81,11 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
             for r in range(1, repeats + 1):
                 items[row + 1 + (r - 1) * n] = InhandItem(
                     task_set=name,
-                    task_id=str(task.task_id[row]),
-                    object=str(task.object[row]),
-                    level=int(task.level[row]),
-                    initial=np.asarray(task.initial[row], float),
-                    desired=np.asarray(task.desired[row], float),
+                    task_id=str(ts.task_id[row]),
+                    object=str(ts.object[row]),
+                    level=int(ts.level[row]),
+                    initial=np.asarray(ts.initial[row], float),
+                    desired=np.asarray(ts.desired[row], float),
                     repeat=r,
                     contacts=contacts,
                     extra=extra,

@@ -2,8 +2,12 @@
 
 Runs in a sweep worker (or inline). Whatever happens inside — a
 :class:`~benchharness.backends.SimulationError`, any exception, a spent
-budget — becomes a :class:`TrialRecord` with a cause and the traceback; the
-only thing that escapes is ``KeyboardInterrupt``/``SystemExit``.
+budget, a ``SystemExit`` (``sys.exit`` in a library's error path) — becomes
+a :class:`TrialRecord` with a cause and the traceback. ``KeyboardInterrupt``
+is the user's Ctrl-C when the trial runs in the sweep's own process and
+escapes there; in a worker process (which ignores SIGINT: the parent owns
+interruption) it can only come from the strategy's code and is contained
+too (``contain_interrupts=True``).
 """
 
 from __future__ import annotations
@@ -87,7 +91,13 @@ def _failure(
     )
 
 
-def execute_trial(spec: RunSpec, index: int, video: VideoSpec | None = None) -> TrialRecord:
+def execute_trial(
+    spec: RunSpec,
+    index: int,
+    video: VideoSpec | None = None,
+    *,
+    contain_interrupts: bool = False,
+) -> TrialRecord:
     """Run trial ``index`` (1-based) of ``spec``; never raises for a failing trial."""
     wall0 = time.perf_counter()
     plan = plan_for(spec)
@@ -160,7 +170,7 @@ def execute_trial(spec: RunSpec, index: int, video: VideoSpec | None = None) -> 
         else:
             verdict = score_inhand(item, outcome)  # type: ignore[arg-type]
         diag = recorder.to_json()
-        if writer is not None:
+        if writer is not None and video is not None:
             diag["video"] = {
                 "path": str(writer.path),
                 "frames": writer.frames_written,
@@ -193,7 +203,9 @@ def execute_trial(spec: RunSpec, index: int, video: VideoSpec | None = None) -> 
             ctx,
             tb.format_exc(),
         )
-    except Exception as exc:  # noqa: BLE001 - any failure ends this trial only
+    except (Exception, SystemExit, KeyboardInterrupt) as exc:  # any of them ends this trial only
+        if isinstance(exc, KeyboardInterrupt) and not contain_interrupts:
+            raise
         cause = FailureCause.SIMULATOR_ERROR if backend is None else FailureCause.STRATEGY_ERROR
         return _failure(
             spec, index, cause, f"{stage}: {type(exc).__name__}: {exc}", wall0, ctx, tb.format_exc()
