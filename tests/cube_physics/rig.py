@@ -210,17 +210,17 @@ def twist(
 ) -> TwistOutcome:
     """Settle, articulate, turn the wrist by ``angle_deg`` about +z, let go of the top, end the twist."""
     cube, b = rig.cube, rig.backend
-    cube.step(rig.seconds(0.05))
+    b.step(rig.seconds(0.05))
     cube.begin_twist(axis, intended=intended)
-    cube.step(rig.seconds(0.02))
+    b.step(rig.seconds(0.02))
     n = rig.seconds(turn_s)
     target = math.radians(angle_deg)
     for i in range(n):
         s = (i + 1) / n
         rig.wrist(target * (3 * s * s - 2 * s**3))  # smooth start and stop
-        cube.step(1)
+        b.step(1)
         rig.wrist_log.append(float(b.get_joint_state(rig.rotator).positions[0]))
-    cube.step(rig.seconds(0.1))
+    b.step(rig.seconds(0.1))
     rig.grip(rig.rotator, closed=False)
-    cube.step(rig.seconds(0.1))
+    b.step(rig.seconds(0.1))
     return cube.end_twist()

@@ -135,16 +135,14 @@ def test_blow_up_is_reported_not_raised(task):
 
     m = get_manager()
     be = m.create("backend", "pybullet")
-    calls = {"n": 0}
-    orig = be.step
+    steps = {"n": 0}
 
-    def step(n: int = 1) -> None:
-        calls["n"] += 1
-        if calls["n"] > 20:
+    def blow_up_after_40_steps() -> None:  # a step callback: exceptions propagate out of step()
+        steps["n"] += 1
+        if steps["n"] > 40:
             raise SimulationError("injected blow-up")
-        orig(n)
 
-    be.step = step
+    be.add_step_callback(blow_up_after_40_steps)
     item = InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired)
     ctx = TrialContext(
         item=item,

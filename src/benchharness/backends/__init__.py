@@ -25,6 +25,7 @@ from .interface import (
     Shape,
     SimulationError,
     Sphere,
+    StepCallback,
 )
 
 __all__ = [
@@ -45,6 +46,7 @@ __all__ = [
     "Shape",
     "SimulationError",
     "Sphere",
+    "StepCallback",
     "PYBULLET_CAPABILITIES",
     "SAPIEN_CAPABILITIES",
     "create_pybullet",
@@ -52,12 +54,8 @@ __all__ = [
 ]
 
 #: capability flags, known without importing the engines (the classes carry the same values)
-PYBULLET_CAPABILITIES = Capabilities(
-    camera=True, mesh_collision=True, joint_friction=True, mimic_joints=False, gravity_torques=True
-)
-SAPIEN_CAPABILITIES = Capabilities(
-    camera=False, mesh_collision=True, joint_friction=True, mimic_joints=False, gravity_torques=True
-)
+PYBULLET_CAPABILITIES = Capabilities(camera=True, gravity_torques=True)
+SAPIEN_CAPABILITIES = Capabilities(camera=False, gravity_torques=True)
 
 
 def create_pybullet(config: PhysicsConfig | None = None) -> Backend:

@@ -90,7 +90,7 @@ def mass_properties(
     if total_v <= 0:
         raise BackendError("shapes have zero volume")
     density = mass / total_v
-    c_body = sum(v * c for v, c in zip(vols, centres)) / total_v
+    c_body = np.asarray(sum(v * c for v, c in zip(vols, centres)), dtype=float) / total_v
     i_body = np.zeros((3, 3))
     for v, c, i in zip(vols, centres, tensors):
         d = c - c_body
@@ -169,9 +169,16 @@ class UrdfModel:
 
 
 def _f(el: ET.Element | None, attr: str, default: float) -> float:
-    if el is None or el.get(attr) is None:
-        return default
-    return float(el.get(attr))
+    v = None if el is None else el.get(attr)
+    return default if v is None else float(v)
+
+
+def _req(el: ET.Element | None, attr: str, path: Path, what: str) -> str:
+    """A required attribute, or a :class:`BackendError` naming the file and the element."""
+    v = None if el is None else el.get(attr)
+    if v is None:
+        raise BackendError(f"{path}: {what} has no {attr!r}")
+    return v
 
 
 def parse_urdf(path: str | Path) -> UrdfModel:
@@ -180,12 +187,12 @@ def parse_urdf(path: str | Path) -> UrdfModel:
         root = ET.parse(path).getroot()
     except (OSError, ET.ParseError) as exc:
         raise BackendError(f"cannot read URDF {path}: {exc}") from exc
-    links = [l.get("name") for l in root.findall("link")]
+    links = [_req(l, "name", path, "a <link>") for l in root.findall("link")]
     masses: dict[str, float] = {}
     for l in root.findall("link"):
         m = l.find("inertial/mass")
         if m is not None:
-            masses[l.get("name")] = float(m.get("value", 0.0))
+            masses[_req(l, "name", path, "a <link>")] = float(m.get("value", 0.0))
     missing = [l for l in links if l not in masses]
     if missing:
         import warnings
@@ -199,9 +206,10 @@ def parse_urdf(path: str | Path) -> UrdfModel:
     children: set[str] = set()
     mimic: list[str] = []
     for j in root.findall("joint"):
-        jtype = j.get("type")
-        parent = j.find("parent").get("link")
-        child = j.find("child").get("link")
+        name = _req(j, "name", path, "a <joint>")
+        jtype = _req(j, "type", path, f"joint {name!r}")
+        parent = _req(j.find("parent"), "link", path, f"the <parent> of joint {name!r}")
+        child = _req(j.find("child"), "link", path, f"the <child> of joint {name!r}")
         children.add(child)
         lim = j.find("limit")
         if jtype == "continuous":
@@ -211,12 +219,12 @@ def parse_urdf(path: str | Path) -> UrdfModel:
         else:
             lo = hi = 0.0
         if jtype not in MOVABLE and jtype != "fixed":
-            raise BackendError(f"{path}: joint {j.get('name')!r} has unsupported type {jtype!r}")
+            raise BackendError(f"{path}: joint {name!r} has unsupported type {jtype!r}")
         if j.find("mimic") is not None:
-            mimic.append(j.get("name"))
+            mimic.append(name)
         joints.append(
             JointInfo(
-                name=j.get("name"),
+                name=name,
                 type=jtype,
                 lower=lo,
                 upper=hi,
@@ -237,11 +245,11 @@ def parse_urdf(path: str | Path) -> UrdfModel:
             "joints); drive those joints explicitly",
             stacklevel=3,
         )
-    m = UrdfModel(
+    model = UrdfModel(
         path=path, root_link=roots[0], links=links, joints=joints, mimic=mimic, masses=masses
     )
-    m.movable = [j for j in joints if j.type in MOVABLE]
-    return m
+    model.movable = [j for j in joints if j.type in MOVABLE]
+    return model
 
 
 def collision_only_copy(path: str | Path) -> str:

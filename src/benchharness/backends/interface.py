@@ -19,7 +19,7 @@ the normal force is about the box's weight.
 from __future__ import annotations
 
 import abc
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
@@ -46,9 +46,13 @@ __all__ = [
     "Shape",
     "SimulationError",
     "Sphere",
+    "StepCallback",
 ]
 
 BodyId = int
+
+#: Called with no arguments after each physics step (see :meth:`Backend.add_step_callback`).
+StepCallback = Callable[[], None]
 
 
 class BackendError(RuntimeError):
@@ -65,15 +69,15 @@ class SimulationError(BackendError):
 
 @dataclass(frozen=True)
 class Capabilities:
-    """What a backend can do. Callers check these instead of catching errors."""
+    """What a backend can do. Callers check these instead of catching errors.
 
-    camera: bool = False  #: :meth:`Backend.render` returns images
-    mesh_collision: bool = True  #: convex mesh collision shapes
-    joint_friction: bool = True  #: :meth:`Backend.set_joint_friction`
-    mimic_joints: bool = False  #: URDF ``<mimic>`` enforced by the engine
-    gravity_torques: bool = (
-        False  #: :meth:`Backend.gravity_torques` (the engine's own inverse dynamics)
-    )
+    Only optional methods get a flag; everything else in the interface
+    (convex meshes, joint friction, ...) every backend must provide.
+    """
+
+    camera: bool = False  #: :meth:`Backend.render` returns images (read by ``run --video``)
+    #: :meth:`Backend.gravity_torques` is the engine's own inverse dynamics (read by ``Robot``)
+    gravity_torques: bool = False
 
 
 @dataclass(frozen=True)
@@ -204,6 +208,9 @@ class Backend(abc.ABC):
 
     def __init__(self, config: PhysicsConfig | None = None) -> None:
         self.config = config or PhysicsConfig()
+        self._step_callbacks: dict[int, StepCallback] = {}  # handle -> fn, in registration order
+        self._next_step_callback = 1
+        self._in_step_callback = False
 
     @property
     def solver_iterations(self) -> int:
@@ -228,9 +235,63 @@ class Backend(abc.ABC):
     def time(self) -> float:
         """Simulated seconds since the world was created."""
 
-    @abc.abstractmethod
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` timesteps. Raises :class:`SimulationError` on a blow-up."""
+        """Advance ``n`` timesteps. Raises :class:`SimulationError` on a blow-up.
+
+        Each physics step runs the engine's step, then every registered step
+        callback in registration order (as dm_control's composer runs its
+        ``after_substep`` hooks), so a callback sees every intermediate state
+        however the caller batches its steps. An exception raised by a
+        callback (or a blow-up) propagates at once: the remaining steps of
+        this call are not taken.
+        """
+        if self._in_step_callback:
+            raise BackendError("a step callback may not step the world")
+        self._step_engine(int(n), self._run_step_callbacks if self._step_callbacks else None)
+
+    def _run_step_callbacks(self) -> None:
+        # a snapshot: a callback added or removed by a callback counts from the next step
+        callbacks = tuple(self._step_callbacks.values())
+        self._in_step_callback = True
+        try:
+            for fn in callbacks:
+                fn()
+        finally:
+            self._in_step_callback = False
+
+    @abc.abstractmethod
+    def _step_engine(self, n: int, after_step: StepCallback | None) -> None:
+        """Advance the engine ``n`` physics steps, calling ``after_step()`` after each.
+
+        The one method an engine implements for time; :meth:`step` calls it
+        (``after_step`` runs the step callbacks, ``None`` when there are
+        none). ``after_step`` runs after the step's own per-step blow-up
+        checks; it may add, remove or drive bodies, which the engine must
+        honour from the next physics step.
+        """
+
+    def add_step_callback(self, fn: StepCallback) -> int:
+        """Call ``fn()`` after every physics step from now on; returns a handle for removal.
+
+        Callbacks run in registration order, after the engine's step and its
+        blow-up check; they may read and command the world (poses, contacts,
+        joint targets, rendering) but not step it. This is how the runner
+        watches budgets and first contact, and how the physical cube keeps
+        its detents current while articulated.
+        """
+        if not callable(fn):
+            raise BackendError(f"a step callback must be callable, got {type(fn).__name__}")
+        h = self._next_step_callback
+        self._next_step_callback += 1
+        self._step_callbacks[h] = fn
+        return h
+
+    def remove_step_callback(self, handle: int) -> None:
+        """Stop calling the callback registered as ``handle`` (an unknown handle raises)."""
+        try:
+            del self._step_callbacks[handle]
+        except KeyError:
+            raise BackendError(f"no step callback with handle {handle}") from None
 
     # -- bodies --------------------------------------------------------------
     @abc.abstractmethod
@@ -285,8 +346,12 @@ class Backend(abc.ABC):
 
     @abc.abstractmethod
     def set_velocity(
-        self, body: BodyId, linear: Sequence[float], angular: Sequence[float]
-    ) -> None: ...
+        self,
+        body: BodyId,
+        linear: Sequence[float] | np.ndarray,
+        angular: Sequence[float] | np.ndarray,
+    ) -> None:
+        """Set the base's linear (of its centre of mass) and angular velocity, world frame."""
 
     @abc.abstractmethod
     def get_link_pose(self, body: BodyId, link: str | None) -> Pose:
@@ -417,6 +482,7 @@ class Backend(abc.ABC):
             lin, ang = self.get_velocity(b)
             if not (
                 np.all(np.isfinite(pose.p))
+                and np.all(np.isfinite(pose.q))
                 and np.all(np.isfinite(lin))
                 and np.all(np.isfinite(ang))
             ):

@@ -29,8 +29,8 @@ import pybullet as pb
 
 from ..geometry import Pose
 from . import PYBULLET_CAPABILITIES
-from ._drives import as_array, drive_command, joint_indices
-from ._urdf import MassProperties, UrdfModel, ground_ray_fixup, mass_properties, parse_urdf
+from ._bodies import BodyRecord, BodyTable, as_array, drive_command
+from ._urdf import MassProperties, ground_ray_fixup, mass_properties, parse_urdf
 from .interface import (
     Backend,
     BackendError,
@@ -47,6 +47,7 @@ from .interface import (
     Shape,
     SimulationError,
     Sphere,
+    StepCallback,
 )
 
 #: a base speed above this (m/s or rad/s) counts as a blow-up, as does a non-finite state
@@ -57,24 +58,13 @@ _ATTACH_MAX_FORCE = 1.0e5
 MASS_MATRIX_REFRESH = 1.0e-3
 
 
-@dataclass
-class _Body:
+@dataclass(kw_only=True)
+class _Body(BodyRecord):
     uid: int
-    name: str
-    urdf: UrdfModel | None
-    link_index: dict[str, int]  #: URDF link name -> pybullet link index (-1 = base)
-    joints: list[JointInfo]
-    joint_index: list[int]
-    base_inertial: Pose  #: base inertial frame in the base link frame
-    fixed: bool
-    # control state, per movable joint (position in self.joints)
-    target_q: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    target_v: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    kp: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    kd: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    fmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    driven: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
-    friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    link_index: dict[str, int] = field(default_factory=dict)  #: URDF link -> pybullet index
+    joint_index: list[int] = field(default_factory=list)  #: pybullet joint index, per movable joint
+    base_inertial: Pose = field(default_factory=Pose)  #: base inertial frame in the base link frame
+    # the drive law's state and caches, per movable joint (position in self.joints)
     q_prev: np.ndarray | None = None  #: joint positions at the start of the last driven step
     q_prev_step: int = -10
     driven_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
@@ -91,8 +81,6 @@ class _Body:
     drive_cache: tuple | None = (
         None  #: per-step constants of the drive law (cleared by set_joint_targets)
     )
-    temp_files: list[str] = field(default_factory=list)
-    jmap: dict[str, int] = field(default_factory=dict)  #: joint name -> index (see _joint_sel)
 
     @property
     def index_link(self) -> dict[int, str | None]:
@@ -122,12 +110,12 @@ class PyBulletBackend(Backend):
             deterministicOverlappingPairs=1,
             physicsClientId=self._cid,
         )
-        self._bodies: dict[int, _Body] = {}  #: our handle -> body (PyBullet reuses its ids)
+        self._bodies: BodyTable[_Body] = BodyTable()  #: our handles (PyBullet reuses its ids)
         self._uid2h: dict[int, int] = {}
-        self._next_handle = 1
         self._constraints: dict[int, int] = {}  #: our handle -> PyBullet constraint id
         self._next_constraint = 1
         self._steps = 0
+        self._step_lists: tuple[list[_Body], list[tuple[int, int]]] | None = None
         self._closed = False
         self._grounds: dict[int, float] = {}
         self._gravity = np.asarray(c.gravity, dtype=float)
@@ -137,12 +125,7 @@ class PyBulletBackend(Backend):
         if self._closed:
             return
         self._closed = True
-        for b in self._bodies.values():
-            for f in b.temp_files:
-                try:
-                    os.unlink(f)
-                except OSError:
-                    pass
+        self._bodies.close()
         try:
             pb.disconnect(physicsClientId=self._cid)
         except pb.error:
@@ -156,21 +139,13 @@ class PyBulletBackend(Backend):
 
     # -- helpers ---------------------------------------------------------------
     def _register(self, b: _Body) -> int:
-        h = self._next_handle
-        self._next_handle += 1
-        if not b.name:
-            b.name = f"body{h}"
-        self._bodies[h] = b
+        self._step_lists = None
+        h = self._bodies.add(self._bodies.new_handle(), b)
         self._uid2h[b.uid] = h
         return h
 
     def _b(self, body: BodyId) -> _Body:
-        if self._closed:
-            raise BackendError("backend is closed")
-        try:
-            return self._bodies[body]
-        except KeyError:
-            raise BackendError(f"no body with handle {body}") from None
+        return self._bodies[body]
 
     def _link(self, b: _Body, link: str | None) -> int:
         if link is None or (b.urdf is not None and link == b.urdf.root_link):
@@ -182,20 +157,26 @@ class PyBulletBackend(Backend):
                 f"body {b.name!r} has no link {link!r}; links: {list(b.link_index)}"
             ) from None
 
-    def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
-        return joint_indices(b, joints)
-
     # -- time ------------------------------------------------------------------
     @property
     def time(self) -> float:
         return self._steps * self.config.timestep
 
-    def step(self, n: int = 1) -> None:
+    def _stepped(self) -> tuple[list[_Body], list[tuple[int, int]]]:
+        """The driven bodies and the movable bases ``(uid, handle)``; cached until bodies or drives change."""
+        if self._step_lists is None:
+            driven = [b for b in self._bodies.values() if b.drive.driven.any()]
+            # bases that can move (a fixed base cannot; its joints are checked after the loop)
+            dynamic = [(b.uid, h) for h, b in self._bodies.items() if not b.fixed]
+            self._step_lists = (driven, dynamic)
+        return self._step_lists
+
+    def _step_engine(self, n: int, after_step: StepCallback | None) -> None:
+        if self._closed:
+            raise BackendError("backend is closed")
         cid = self._cid
-        driven = [b for b in self._bodies.values() if b.driven.any()]
-        # bases that can move (a fixed base cannot; its joints are checked after the loop)
-        dynamic = [(b.uid, h) for h, b in self._bodies.items() if not b.fixed]
-        for _ in range(int(n)):
+        for _ in range(n):
+            driven, dynamic = self._stepped()
             for b in driven:
                 self._apply_drives(b)
             pb.stepSimulation(physicsClientId=cid)
@@ -212,7 +193,13 @@ class PyBulletBackend(Backend):
                 )
                 if not s < MAX_SPEED:  # also catches NaN
                     self._blowup(h)
+            if after_step is not None:
+                after_step()
         for h, b in self._bodies.items():
+            # a non-finite pose can come with finite velocities (e.g. teleported there)
+            p, q = pb.getBasePositionAndOrientation(b.uid, physicsClientId=cid)
+            if not math.isfinite(p[0] + p[1] + p[2] + q[0] + q[1] + q[2] + q[3]):
+                self._blowup(h)
             if b.joints:
                 for st in pb.getJointStates(b.uid, b.joint_index, physicsClientId=cid):
                     if not (math.isfinite(st[0]) and abs(st[1]) < MAX_SPEED):
@@ -294,9 +281,9 @@ class PyBulletBackend(Backend):
                 minv = np.linalg.inv(m)
             except np.linalg.LinAlgError:
                 minv = np.diag(1.0 / np.maximum(np.diag(m), 1e-12))
-            n = len(q)
             b.minv, b.minv_q = minv, q.copy()
-            b.meff = 1.0 / np.diag(minv)[m.shape[0] - n :]
+            b.meff = 1.0 / np.diag(minv)[m.shape[0] - len(q) :]
+        assert b.meff is not None  # set together with minv
         return b.minv, b.meff
 
     def _apply_drives(self, b: _Body) -> None:
@@ -335,11 +322,20 @@ class PyBulletBackend(Backend):
         b.q_prev_step = self._steps
         minv, meff = self._mass_inverse(b, q)
         if b.drive_cache is None:  # the drive settings' per-step constants, until set_joint_targets
-            k, d = b.kp[sel], b.kd[sel]
+            ds = b.drive
+            k, d = ds.kp[sel], ds.kd[sel]
             c = k * dt + d
             with np.errstate(divide="ignore"):
                 inv_c = np.where(c > 0, 1.0 / c, 0.0)
-            b.drive_cache = (k, d * b.target_v[sel], b.target_q[sel], c, dt * c, inv_c, b.fmax[sel])
+            b.drive_cache = (
+                k,
+                d * ds.target_v[sel],
+                ds.target_q[sel],
+                c,
+                dt * c,
+                inv_c,
+                ds.fmax[sel],
+            )
         k, dv, tq, c, dtc, inv_c, fmax = b.drive_cache
         m = meff[sel]
         if b.fixed:
@@ -390,7 +386,7 @@ class PyBulletBackend(Backend):
         pb.changeDynamics(
             uid, -1, lateralFriction=fr, spinningFriction=self._spinning(fr), physicsClientId=cid
         )
-        h = self._register(_Body(uid, "ground", None, {}, [], [], Pose(), True))
+        h = self._register(_Body(uid=uid, name="ground", fixed=True))
         self._grounds[h] = float(height)
         return h
 
@@ -473,7 +469,13 @@ class PyBulletBackend(Backend):
         if vis >= 0:
             pb.changeVisualShape(uid, -1, rgbaColor=[0.45, 0.5, 0.6, 1], physicsClientId=cid)
         return self._register(
-            _Body(uid, name or "", None, {}, [], [], mp.inertial_pose, fixed, temp_files=tmp)
+            _Body(
+                uid=uid,
+                name=name or "",
+                base_inertial=mp.inertial_pose,
+                fixed=fixed,
+                temp_files=tmp,
+            )
         )
 
     def _shape_arrays(self, shapes: list[Shape], tmp: list[str]) -> tuple[list, ...]:
@@ -481,7 +483,14 @@ class PyBulletBackend(Backend):
 
         Returns ``(types, half_extents, radii, lengths, file_names, positions, orientations)``.
         """
-        types, half, radii, lengths, files, poss, orns = [], [], [], [], [], [], []
+        types: list[int] = []
+        half: list[list[float]] = []
+        radii: list[float] = []
+        lengths: list[float] = []
+        files: list[str] = []
+        poss: list[list[float]] = []
+        orns: list[list[float]] = []
+        fields: tuple[int, list[float], float, float, str]
         for s in shapes:
             if isinstance(s, MeshShape):
                 fields = (pb.GEOM_MESH, [0, 0, 0], 0.0, 0.0, self._hull_obj(s, tmp))
@@ -499,8 +508,11 @@ class PyBulletBackend(Backend):
                 )
             else:
                 raise BackendError(f"unknown shape {type(s).__name__}")
-            for column, value in zip((types, half, radii, lengths, files), fields):
-                column.append(value)
+            types.append(fields[0])
+            half.append(fields[1])
+            radii.append(fields[2])
+            lengths.append(fields[3])
+            files.append(fields[4])
             poss.append(s.pose.p.tolist())
             orns.append(s.pose.q.tolist())
         return types, half, radii, lengths, files, poss, orns
@@ -619,23 +631,15 @@ class PyBulletBackend(Backend):
                     )
         di = pb.getDynamicsInfo(uid, -1, physicsClientId=cid)
         base_inertial = Pose(di[3], di[4])
-        n = len(joints)
         b = _Body(
-            uid,
-            name or model.root_link,
-            model,
-            link_index,
-            joints,
-            jidx,
-            base_inertial,
-            bool(fixed_base),
-            target_q=np.zeros(n),
-            target_v=np.zeros(n),
-            kp=np.zeros(n),
-            kd=np.zeros(n),
-            fmax=np.zeros(n),
-            driven=np.zeros(n, dtype=bool),
-            friction=np.zeros(n),
+            uid=uid,
+            name=name or model.root_link,
+            urdf=model,
+            link_index=link_index,
+            joints=joints,
+            joint_index=jidx,
+            base_inertial=base_inertial,
+            fixed=bool(fixed_base),
         )
         h = self._register(b)
         self.set_pose(h, base_pose)
@@ -648,12 +652,8 @@ class PyBulletBackend(Backend):
             if b.uid in (info[0], info[2]):
                 self.detach(c)
         pb.removeBody(b.uid, physicsClientId=self._cid)
-        for f in b.temp_files:
-            try:
-                os.unlink(f)
-            except OSError:
-                pass
-        del self._bodies[body]
+        self._bodies.pop(body)
+        self._step_lists = None
         self._uid2h.pop(b.uid, None)
         self._grounds.pop(body, None)
 
@@ -676,7 +676,12 @@ class PyBulletBackend(Backend):
         lin, ang = pb.getBaseVelocity(b.uid, physicsClientId=self._cid)
         return np.asarray(lin, dtype=float), np.asarray(ang, dtype=float)
 
-    def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
+    def set_velocity(
+        self,
+        body: BodyId,
+        linear: Sequence[float] | np.ndarray,
+        angular: Sequence[float] | np.ndarray,
+    ) -> None:
         b = self._b(body)
         pb.resetBaseVelocity(
             b.uid, list(map(float, linear)), list(map(float, angular)), physicsClientId=self._cid
@@ -723,7 +728,7 @@ class PyBulletBackend(Backend):
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
     ) -> None:
         b = self._b(body)
-        sel = self._joint_sel(b, joints)
+        sel = b.joint_indices(joints)
         pos = as_array(positions, len(sel), "positions")
         b.q_prev = None  # a teleport is not motion
         b.minv = None
@@ -742,7 +747,7 @@ class PyBulletBackend(Backend):
         force_limit: float | Sequence[float] | None = None,
     ) -> None:
         b = self._b(body)
-        sel = np.asarray(self._joint_sel(b, joints), dtype=int)
+        sel = np.asarray(b.joint_indices(joints), dtype=int)
         n = len(sel)
         if n == 0:
             return
@@ -756,10 +761,9 @@ class PyBulletBackend(Backend):
             force_limit,
             lambda: self.get_joint_state(body).positions,
         )
-        q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
-        b.target_q[sel], b.target_v[sel], b.kp[sel], b.kd[sel], b.fmax[sel] = q, v, k, d, f
-        b.driven[sel] = True
-        b.driven_idx = np.nonzero(b.driven)[0]
+        b.drive.set_targets(sel, cmd)
+        self._step_lists = None  # the body may be newly driven
+        b.driven_idx = np.nonzero(b.drive.driven)[0]
         b.driven_pb = [b.joint_index[i] for i in b.driven_idx]
         b.ones = [1.0] * len(b.driven_pb)
         b.drive_cache = None
@@ -768,11 +772,11 @@ class PyBulletBackend(Backend):
         self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None
     ) -> None:
         b = self._b(body)
-        sel = self._joint_sel(b, joints)
+        sel = b.joint_indices(joints)
         t = as_array(torques, len(sel), "torques")
         for i, tau in zip(sel, t):
-            b.friction[i] = float(tau)
-            if not b.driven[i]:
+            b.drive.friction[i] = float(tau)
+            if not b.drive.driven[i]:
                 pb.setJointMotorControl2(
                     b.uid,
                     b.joint_index[i],

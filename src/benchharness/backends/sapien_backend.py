@@ -31,10 +31,9 @@ import numpy as np
 
 from ..geometry import Pose
 from . import SAPIEN_CAPABILITIES
-from ._drives import as_array, drive_command, joint_indices
+from ._bodies import BodyRecord, BodyTable, as_array, drive_command
 from ._urdf import (
     MassProperties,
-    UrdfModel,
     collision_only_copy,
     ground_ray_fixup,
     mass_properties,
@@ -55,6 +54,7 @@ from .interface import (
     Shape,
     SimulationError,
     Sphere,
+    StepCallback,
 )
 
 with warnings.catch_warnings():
@@ -69,7 +69,7 @@ _ATTACH_STIFFNESS = 1.0e7
 _ATTACH_DAMPING = 1.0e4
 _ATTACH_MAX_FORCE = 1.0e5
 # x axis -> z axis: SAPIEN cylinders run along x, ours along z
-_X_TO_Z = Pose([0, 0, 0], [0.0, -math.sqrt(0.5), 0.0, math.sqrt(0.5)])
+_X_TO_Z = Pose(np.zeros(3), np.array([0.0, -math.sqrt(0.5), 0.0, math.sqrt(0.5)]))
 
 
 def _sp(pose: Pose) -> sapien.Pose:
@@ -81,38 +81,25 @@ def _sp(pose: Pose) -> sapien.Pose:
 
 def _bp(pose: sapien.Pose) -> Pose:
     q = pose.q
-    return Pose(np.asarray(pose.p, dtype=float), [q[1], q[2], q[3], q[0]])
+    return Pose(np.asarray(pose.p, dtype=float), np.array([q[1], q[2], q[3], q[0]], dtype=float))
 
 
-@dataclass
-class _Body:
+@dataclass(kw_only=True)
+class _Body(BodyRecord):
     handle: int
-    name: str
     entity: Any = None  #: actor entity (rigid bodies)
     component: Any = None  #: PhysxRigidDynamicComponent / PhysxRigidStaticComponent
     articulation: Any = None
-    urdf: UrdfModel | None = None
     links: dict[str, Any] = field(default_factory=dict)  #: URDF name -> link component
-    joints: list[JointInfo] = field(default_factory=list)
     sjoints: list[Any] = field(default_factory=list)  #: SAPIEN joints in our order
     perm: np.ndarray = field(
         default_factory=lambda: np.zeros(0, dtype=int)
     )  #: ours -> active index
-    fixed: bool = False
-    driven: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
-    target_q: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    target_v: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    kp: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    kd: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    fmax: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    friction: np.ndarray = field(default_factory=lambda: np.zeros(0))
     drive_props: dict[int, tuple[float, float, float]] = field(default_factory=dict)
     drive_targets: dict[int, tuple[float, float]] = field(
         default_factory=dict
     )  #: last (q*, v*) sent
     gravity_tree: Any = None  #: cached (links, downstream mask, prismatic, masses) for a free base
-    temp_files: list[str] = field(default_factory=list)
-    jmap: dict[str, int] = field(default_factory=dict)  #: joint name -> index (see _joint_sel)
 
     @property
     def root(self) -> Any:
@@ -139,12 +126,12 @@ class SapienBackend(Backend):
         self._system = physx.PhysxCpuSystem()
         self._scene = sapien.Scene([self._system])
         self._scene.set_timestep(c.timestep)
-        self._bodies: dict[int, _Body] = {}
+        self._bodies: BodyTable[_Body] = BodyTable()
         self._entity_map: dict[int, tuple[int, str | None]] = {}  # per_scene_id -> (handle, link)
         self._constraints: dict[int, Any] = {}
-        self._next = 1
         self._next_constraint = 1
         self._steps = 0
+        self._roots: list[tuple[int, Any]] | None = None  #: movable bases, see _step_engine
         self._closed = False
         self._grounds: dict[int, float] = {}
         self._materials: dict[float, Any] = {}
@@ -170,13 +157,7 @@ class SapienBackend(Backend):
         if self._closed:
             return
         self._closed = True
-        for b in self._bodies.values():
-            for f in b.temp_files:
-                try:
-                    os.unlink(f)
-                except OSError:
-                    pass
-        self._bodies.clear()
+        self._bodies.close()
         self._constraints.clear()
         self._entity_map.clear()
         try:
@@ -188,12 +169,7 @@ class SapienBackend(Backend):
 
     # -- helpers ---------------------------------------------------------------
     def _b(self, body: BodyId) -> _Body:
-        if self._closed:
-            raise BackendError("backend is closed")
-        try:
-            return self._bodies[body]
-        except KeyError:
-            raise BackendError(f"no body with handle {body}") from None
+        return self._bodies[body]
 
     def _link(self, b: _Body, link: str | None) -> Any:
         if link is None:
@@ -207,36 +183,34 @@ class SapienBackend(Backend):
                 f"body {b.name!r} has no link {link!r}; links: {list(b.links)}"
             ) from None
 
-    def _joint_sel(self, b: _Body, joints: Sequence[str] | None) -> list[int]:
-        return joint_indices(b, joints)
-
     def _register(self, b: _Body) -> int:
-        self._bodies[b.handle] = b
+        self._roots = None
+        self._bodies.add(b.handle, b)
         if b.articulation is not None:
+            root = b.urdf.root_link if b.urdf is not None else None
             for name, comp in b.links.items():
-                link = None if name == b.urdf.root_link else name
+                link = None if name == root else name
                 self._entity_map[comp.entity.per_scene_id] = (b.handle, link)
         else:
             self._entity_map[b.entity.per_scene_id] = (b.handle, None)
         return b.handle
 
     def _new_handle(self) -> int:
-        h = self._next
-        self._next += 1
-        return h
+        return self._bodies.new_handle()
 
     # -- time ------------------------------------------------------------------
     @property
     def time(self) -> float:
         return self._steps * self.config.timestep
 
-    def step(self, n: int = 1) -> None:
+    def _step_engine(self, n: int, after_step: StepCallback | None) -> None:
         if self._closed:
             raise BackendError("backend is closed")
-        # bases that can move (a fixed base cannot; articulation joints are checked after the loop)
-        roots = [(h, b.root) for h, b in self._bodies.items() if not b.fixed]
-        arts = [(h, b.articulation) for h, b in self._bodies.items() if b.articulation is not None]
-        for _ in range(int(n)):
+        for _ in range(n):
+            if self._roots is None:  # cached until a body is added or removed
+                # bases that can move (a fixed base cannot; joints are checked after the loop)
+                self._roots = [(h, b.root) for h, b in self._bodies.items() if not b.fixed]
+            roots = self._roots
             self._scene.step()
             self._steps += 1
             for h, comp in roots:
@@ -245,9 +219,21 @@ class SapienBackend(Backend):
                 s = abs(lv[0]) + abs(lv[1]) + abs(lv[2]) + abs(av[0]) + abs(av[1]) + abs(av[2])
                 if not s < MAX_SPEED:
                     self._blowup(h)
-        for h, art in arts:
-            if not (np.all(np.isfinite(art.qpos)) and np.all(np.abs(art.qvel) < MAX_SPEED)):
+            if after_step is not None:
+                after_step()
+        # base poses (a non-finite pose can come with finite velocities) and joint states; sums
+        # and maxima instead of np.isfinite on these tiny arrays: a third of the cost, NaN included
+        for h, b in self._bodies.items():
+            pose = b.root.entity_pose
+            p, q = pose.p, pose.q
+            if not math.isfinite(p[0] + p[1] + p[2] + q[0] + q[1] + q[2] + q[3]):
                 self._blowup(h)
+            art = b.articulation
+            if art is not None and art.dof:
+                if not math.isfinite(float(art.qpos.sum())):
+                    self._blowup(h)
+                if not float(np.abs(art.qvel).max()) < MAX_SPEED:  # NaN compares False
+                    self._blowup(h)
 
     def _blowup(self, h: int) -> None:
         raise SimulationError(
@@ -262,7 +248,9 @@ class SapienBackend(Backend):
         h = self._new_handle()
         comp = ent.find_component_by_type(physx.PhysxRigidStaticComponent)
         self._grounds[h] = float(height)
-        return self._register(_Body(h, "ground", entity=ent, component=comp, fixed=True))
+        return self._register(
+            _Body(handle=h, name="ground", entity=ent, component=comp, fixed=True)
+        )
 
     def add_body(
         self,
@@ -318,7 +306,9 @@ class SapienBackend(Backend):
             comp = ent.find_component_by_type(physx.PhysxRigidDynamicComponent)
             comp.linear_damping = 0.0  # no artificial damping (PhysX defaults to 0.05 angular)
             comp.angular_damping = 0.0
-        return self._register(_Body(h, nm, entity=ent, component=comp, fixed=fixed, temp_files=tmp))
+        return self._register(
+            _Body(handle=h, name=nm, entity=ent, component=comp, fixed=fixed, temp_files=tmp)
+        )
 
     def load_urdf(
         self,
@@ -379,10 +369,9 @@ class SapienBackend(Backend):
                     g = list(shape.collision_groups)
                     g[2] |= 1 << bit
                     shape.set_collision_groups(g)
-        n = len(joints)
         b = _Body(
-            h,
-            name or model.root_link,
+            handle=h,
+            name=name or model.root_link,
             articulation=art,
             urdf=model,
             links=links,
@@ -390,13 +379,6 @@ class SapienBackend(Backend):
             sjoints=sjoints,
             perm=perm,
             fixed=bool(fixed_base),
-            driven=np.zeros(n, dtype=bool),
-            target_q=np.zeros(n),
-            target_v=np.zeros(n),
-            kp=np.zeros(n),
-            kd=np.zeros(n),
-            fmax=np.zeros(n),
-            friction=np.zeros(n),
         )
         art.set_root_pose(_sp(base_pose))
         art.set_qpos(np.zeros(art.dof, dtype=np.float32))
@@ -414,12 +396,8 @@ class SapienBackend(Backend):
         else:
             self._entity_map.pop(b.entity.per_scene_id, None)
             self._scene.remove_entity(b.entity)
-        for f in b.temp_files:
-            try:
-                os.unlink(f)
-            except OSError:
-                pass
-        del self._bodies[body]
+        self._bodies.pop(body)
+        self._roots = None
         self._grounds.pop(body, None)
 
     def get_pose(self, body: BodyId) -> Pose:
@@ -444,7 +422,12 @@ class SapienBackend(Backend):
             r.angular_velocity, dtype=float
         )
 
-    def set_velocity(self, body: BodyId, linear: Sequence[float], angular: Sequence[float]) -> None:
+    def set_velocity(
+        self,
+        body: BodyId,
+        linear: Sequence[float] | np.ndarray,
+        angular: Sequence[float] | np.ndarray,
+    ) -> None:
         b = self._b(body)
         lin = np.asarray(linear, dtype=np.float32)
         ang = np.asarray(angular, dtype=np.float32)
@@ -485,18 +468,13 @@ class SapienBackend(Backend):
         q = np.asarray(art.qpos, dtype=float)[b.perm]
         v = np.asarray(art.qvel, dtype=float)[b.perm]
         # PhysX does not report drive forces: evaluate the (capped) drive law at the current state
-        eff = np.where(
-            b.driven,
-            np.clip(b.kp * (b.target_q - q) + b.kd * (b.target_v - v), -b.fmax, b.fmax),
-            -np.sign(v) * b.friction,
-        )
-        return JointState(q, v, eff)
+        return JointState(q, v, b.drive.efforts(q, v))
 
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
     ) -> None:
         b = self._b(body)
-        sel = self._joint_sel(b, joints)
+        sel = b.joint_indices(joints)
         pos = as_array(positions, len(sel), "positions")
         art = b.articulation
         q = np.asarray(art.qpos, dtype=np.float32).copy()
@@ -519,7 +497,7 @@ class SapienBackend(Backend):
         force_limit: float | Sequence[float] | None = None,
     ) -> None:
         b = self._b(body)
-        sel = np.asarray(self._joint_sel(b, joints), dtype=int)
+        sel = np.asarray(b.joint_indices(joints), dtype=int)
         n = len(sel)
         if n == 0:
             return
@@ -533,9 +511,8 @@ class SapienBackend(Backend):
             force_limit,
             lambda: self.get_joint_state(body).positions,
         )
+        b.drive.set_targets(sel, cmd)
         q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
-        b.target_q[sel], b.target_v[sel], b.kp[sel], b.kd[sel], b.fmax[sel] = q, v, k, d, f
-        b.driven[sel] = True
         # PhysX keeps drive settings until changed: only changed values are sent (a held robot
         # re-sends the same targets every control tick, and each setter is a C++ call)
         props, targets = b.drive_props, b.drive_targets
@@ -608,11 +585,11 @@ class SapienBackend(Backend):
         self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None
     ) -> None:
         b = self._b(body)
-        sel = self._joint_sel(b, joints)
+        sel = b.joint_indices(joints)
         t = as_array(torques, len(sel), "torques")
         for i, tau in zip(sel, t):
-            b.friction[i] = float(tau)
-            if not b.driven[i]:
+            b.drive.friction[i] = float(tau)
+            if not b.drive.driven[i]:
                 j = b.sjoints[i]
                 prop = (0.0, _FRICTION_DAMPING if tau > 0 else 0.0, float(tau))
                 j.set_drive_property(*prop, "force")

@@ -10,7 +10,7 @@ Life cycle::
 
     cube = PhysicalCube(backend, pose)        # rigid 57 mm / 94 g box
     cube.begin_twist("z", intended="U")       # swapped in place for 3 slabs
-    ... grippers act; advance with cube.step(n) (or backend.step + cube.update) ...
+    ... grippers act; advance with backend.step(n) ...
     outcome = cube.end_twist()                # measured, snapped, state updated, rigid again
 
 The articulated cube's joints carry one drive each (the engines give a joint
@@ -18,7 +18,11 @@ one drive): a spring toward the nearest multiple of 90° plus a damper, capped
 at ``friction + detent torque``. Moving, the damper saturates at the cap, so
 the joint shows Coulomb friction; at rest, the spring pulls a loose layer into
 its detent with at most the cap. The target follows the joint across ±45°,
-which is why the cube must be updated every step while articulated.
+which is why the cube must be updated after every physics step while
+articulated: it registers :meth:`update` as a step callback of the backend
+(:meth:`~benchharness.backends.Backend.add_step_callback`) when it swaps to
+the three slabs and removes it when it goes rigid again, so whoever steps the
+world keeps the detents current.
 """
 
 from __future__ import annotations
@@ -94,6 +98,7 @@ class PhysicalCube:
         self._targets = np.zeros(2, dtype=np.int64)  # detent targets, in quarter turns
         self._gains: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self.history: list[TwistOutcome] = []
+        self._callback: int | None = None  #: step-callback handle while articulated
         self._body: BodyId = self._spawn_rigid(pose, linear_velocity, angular_velocity)
 
     # -- read-only views ------------------------------------------------------------
@@ -222,7 +227,8 @@ class PhysicalCube:
     def update(self) -> None:
         """Move each detent's target to the multiple of 90° nearest its joint.
 
-        Call after every :meth:`Backend.step` while articulated (or use :meth:`step`).
+        The backend calls it after every physics step while the cube is
+        articulated (a step callback); calling it yourself is harmless.
         """
         if self._axis is None:
             return
@@ -231,12 +237,6 @@ class PhysicalCube:
         if not np.array_equal(k, self._targets):
             self._targets = k
             self._apply_detent()
-
-    def step(self, n: int = 1) -> None:
-        """Advance the world ``n`` steps, keeping the detents up to date."""
-        for _ in range(int(n)):
-            self.update()
-            self.backend.step(1)
 
     def end_twist(self) -> TwistOutcome:
         """Read the layers, snap them, update the logical state and go rigid again.
@@ -265,11 +265,14 @@ class PhysicalCube:
 
     def remove(self) -> None:
         """Take the cube out of the world."""
+        self._stop_updates()
         self.backend.remove_body(self._body)
         self._axis = None
 
     # -- internals ------------------------------------------------------------------------
-    def _spawn_rigid(self, pose: Pose, lin: Sequence[float], ang: Sequence[float]) -> BodyId:
+    def _spawn_rigid(
+        self, pose: Pose, lin: Sequence[float] | np.ndarray, ang: Sequence[float] | np.ndarray
+    ) -> BodyId:
         c = self.config
         body = self.backend.add_body(
             [Box(rigid_half_extents(c))],
@@ -297,6 +300,13 @@ class PhysicalCube:
         b.set_velocity(self._body, lin, ang)
         self._axis = axis
         self._targets = np.zeros(2, dtype=np.int64)
+        if self._callback is None:
+            self._callback = b.add_step_callback(self.update)
+
+    def _stop_updates(self) -> None:
+        if self._callback is not None:
+            self.backend.remove_step_callback(self._callback)
+            self._callback = None
 
     def _configure_joints(self) -> None:
         c = self.config
@@ -348,6 +358,7 @@ class PhysicalCube:
             list(JOINT_NAMES),
         )
         b.set_pose(self._body, snapped)
+        self._stop_updates()
         b.remove_body(self._body)
         self._body = self._spawn_rigid(snapped, lin, ang)
         self._axis = None

@@ -1,9 +1,9 @@
-"""What the runner does at every ``backend.step``: budget, first contact, video frames.
+"""What the runner does after every physics step: budget, first contact, video frames.
 
-``backend.step`` is the one call every strategy, robot and cube mechanism
-makes to advance time, so the runner wraps it on the trial's backend
-instance (an instance attribute shadowing the method; ``isinstance`` checks
-and the engine are untouched) instead of asking strategies to cooperate.
+The runner registers one step callback on the trial's backend
+(:meth:`~benchharness.backends.Backend.add_step_callback`), so whatever
+advances time — a strategy, a robot, the cube mechanism — is watched at
+physics-step resolution without asking strategies to cooperate.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import signal
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from types import FrameType
 
 from ..backends.interface import CameraSpec
 from .contract import TrialContext, TrialTimeout
@@ -21,6 +22,14 @@ __all__ = ["StepHooks", "wall_alarm"]
 
 
 class StepHooks:
+    """The runner's step callback for one trial: install before the strategy runs, uninstall after.
+
+    After each physics step: the first contact between the watched bodies
+    (checked until one is seen, so ``first_contact_s`` is exact to a step),
+    the video frames due by the new simulated time, then the budgets (a
+    spent budget raises :class:`TrialTimeout` out of ``backend.step``).
+    """
+
     def __init__(
         self,
         ctx: TrialContext,
@@ -28,45 +37,31 @@ class StepHooks:
         camera: CameraSpec | None = None,
         fps: float = 30.0,
     ) -> None:
+        if video is not None and camera is None:
+            raise ValueError("a video needs a camera")
         self.ctx = ctx
         self.backend = ctx.backend
         self.video, self.camera, self.fps = video, camera, fps
         self._next_frame = ctx.sim_start
-        self._orig = None
+        self._handle: int | None = None
 
     def install(self) -> None:
-        self._orig = self.backend.step
-        self.backend.step = self._step  # type: ignore[method-assign]
+        if self._handle is None:
+            self._handle = self.backend.add_step_callback(self._after_step)
 
     def uninstall(self) -> None:
-        if self._orig is not None:
-            try:
-                del self.backend.step
-            except AttributeError:
-                pass
-            self._orig = None
+        if self._handle is not None:
+            self.backend.remove_step_callback(self._handle)
+            self._handle = None
 
-    def _fine(self) -> bool:
-        rec = self.ctx.recorder
-        return self.video is not None or (bool(rec.watched) and rec.first_contact_s is None)
-
-    def _step(self, n: int = 1) -> None:
-        if not self._fine():
-            self._orig(n)
-            self._after()
-            return
-        for _ in range(int(n)):  # one at a time: contact times and frames at step resolution
-            self._orig(1)
-            self._after()
-
-    def _after(self) -> None:
+    def _after_step(self) -> None:
         rec = self.ctx.recorder
         if rec.watched and rec.first_contact_s is None:
             for a, b in rec.watched:
                 if self.backend.contacts(a, b):
                     rec.contact()
                     break
-        if self.video is not None:
+        if self.video is not None and self.camera is not None:
             t = float(self.backend.time)
             while t + 1e-9 >= self._next_frame:
                 self.video.write(self.backend.render(self.camera))
@@ -81,17 +76,13 @@ def wall_alarm(seconds: float | None) -> Iterator[None]:
     Only on Unix and in the main thread (sweep workers and the CLI are); a
     little slack over the budget lets the per-step check speak first.
     """
-    usable = (
-        seconds is not None
-        and hasattr(signal, "setitimer")
-        and threading.current_thread() is threading.main_thread()
-    )
-    if not usable:
+    usable = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
+    if seconds is None or not usable:
         yield
         return
     limit = float(seconds) * 1.1 + 1.0
 
-    def _raise(signum, frame):
+    def _raise(signum: int, frame: FrameType | None) -> None:
         raise TrialTimeout(
             f"wall-time budget of {seconds:g} s spent (no step returned for a while)"
         )

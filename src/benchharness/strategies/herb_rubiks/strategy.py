@@ -161,20 +161,10 @@ class PushGraspStrategy:
             [cfg.cube_xy[0], cfg.cube_xy[1], h + CUBE_HALF + 5e-4],
             Rotation.from_euler("z", -90, degrees=True),
         )
-        self.cube = cube = PhysicalCube(b, true0)
+        self.cube = PhysicalCube(b, true0)
         self.robot = ctx.robot
         self.robot.spawn(b)
-        orig_step = b.step
-
-        def step(n: int = 1) -> None:  # keep the cube's detents current whatever steps the world
-            orig_step(n)
-            cube.update()
-
-        b.step = step
-        try:
-            return self._run(ctx)
-        finally:
-            b.step = orig_step
+        return self._run(ctx)  # the cube keeps its own detents current (a step callback)
 
     def _run(self, ctx: TrialContext) -> TrialOutcome:
         cfg, rec, b = self.config, ctx.recorder, self.b
