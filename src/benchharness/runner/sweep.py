@@ -42,7 +42,7 @@ from typing import Any, Literal
 
 from .causes import FailureCause, TrialStatus
 from .contract import TimeBudget
-from .plugins import lookup
+from .plugins import check_strategy_robot, lookup
 from .records import TrialRecord
 from .spec import RunSpec
 from .store import ClaimOwner, ResultsStore
@@ -127,6 +127,7 @@ def prepare(spec: RunSpec) -> TaskPlan:
     for s in spec.sensors:
         lookup("sensor", s, spec.plugins)
     item = lookup("strategy", spec.strategy, spec.plugins)
+    check_strategy_robot(spec.strategy, spec.robot, spec.plugins)  # the Python API too, not only the CLI
     supported = item.meta.get("benchmarks") or getattr(item.factory, "benchmarks", None)
     if supported is not None and plan.benchmark not in tuple(supported):
         raise ValueError(
