@@ -19,20 +19,19 @@ __all__ = ["ErrorConfig", "HerbPushGraspConfig"]
 class HerbPushGraspConfig:
     """Scene, pre-shapes, push and motion settings (metres, seconds, radians, newtons)."""
 
-    #: table top height (m): the cube's middle (0.9285 m) is a short reach below HERB's home hands
-    #: (1.03 m). Lower (0.80 m) the side pick needs WAM joint 2 at its 2.0 rad limit, where the arm sags
-    #: 2-3 cm under gravity.
+    #: table top height (m): the cube's middle at 0.9285 m, level with the WAM shoulders (j1 at
+    #: 0.9126 m, herb_description).
     table_height: float = 0.90
-    #: half extents (x, y) of the table top (m): narrow in y so that the picking palm and the
-    #: thumb's root pass beside it.
-    table_half_size: tuple[float, float] = (0.10, 0.04)
-    #: cube centre on the table, robot base frame (x forward, y left): between the two WAMs.
+    #: half extents (x, y) of the table top (m): narrower in y than the cube (28.5 mm) so that the
+    #: picking palm and the thumb, whose flex axis is 50 mm off the palm axis, pass beside it (at
+    #: 0.04 m the holder's thumb struck the table edge, folded 14 deg and shoved the cube 6 mm).
+    table_half_size: tuple[float, float] = (0.10, 0.02)
+    #: cube centre on the table, robot base frame (x forward, y left): between the two WAMs, 0.55 m in
+    #: front of their j1 axes (x 0.351 m): nearer, the folded arms reach no side of the cube (an IK scan
+    #: of the push-grasp frames on the published mount, docs/herb_push_grasp.md).
     cube_xy: tuple[float, float] = (0.90, 0.0)
-    #: cube centre while twisting (robot base frame); both WAMs reach every push-grasp and hand-over
-    #: turn there (measured, SAPIEN, Rubiks-1-5 trial 1). 25 cm above the table top: at 10 cm a giver
-    #: turning the cube in front, pinch axis vertical, put a finger (75 mm off the palm axis at spread
-    #: 90 deg) on the table. 75 cm forward: nearer (58-68 cm) a giver in front needs WAM joint 2 at its
-    #: 2.0 rad limit, where link 3 meets link 1 and the arm stops 4-6 cm short.
+    #: cube centre while twisting (robot base frame): 20 cm above the table top, where the IK scan
+    #: finds push-grasps of every side but the far one (+x) for both arms (x 0.9 m, z 0.8-1.1 m).
     twist_position: tuple[float, float, float] = (0.90, 0.0, 1.10)
     #: spread of F1/F2 (rad): 90 deg puts the outer fingers face to face across the tool x axis.
     spread: float = math.pi / 2
@@ -41,13 +40,16 @@ class HerbPushGraspConfig:
     #: cube's sides during the push) without spreading the hand 17 cm wide (docs/herb_push_grasp.md).
     outer_open_flex: float = math.radians(60.0)
     #: thumb (F3, the "middle finger") flex of the rotator's pre-shape (rad). From FK of the corrected
-    #: hand (docs/herb_push_grasp.md): the distal link's farthest corner stands 29.4 mm beyond the tool
-    #: frame, 3 mm off the palm axis; the closing outer fingers meet a 57 mm cube's sides ~37 mm beyond
-    #: the tool frame, so they land ~8 mm deep, on the outer slab (0-19 mm).
-    rotator_thumb_flex: float = math.radians(104.0)
-    #: thumb flex of the holder's pre-shape (rad): tip 12.8 mm beyond the tool frame (its proximal link
-    #: 12.3 mm, just behind), pinch ~24 mm deep, on the middle slab (19-38 mm).
-    holder_thumb_flex: float = math.radians(128.0)
+    #: hand (docs/herb_push_grasp.md): the distal link's farthest corner stands 33.2 mm beyond the tool
+    #: frame, 14.7 mm past the palm axis; the closing outer fingers meet the cube's sides 3-7 mm deep
+    #: (measured), on the outer slab, their distal boxes reaching ~19 mm deep. Deeper (104 deg, 29.4 mm)
+    #: the rotator's fingertips struck the holder's during the twist (51 N, the layer turned 62-73 deg).
+    rotator_thumb_flex: float = math.radians(100.0)
+    #: thumb flex of the holder's pre-shape (rad): tip 18.9 mm beyond the tool frame; its fingers meet
+    #: the sides 15-23 mm deep (across the 19 mm slab boundary: both held slabs) and their distal boxes
+    #: end ~35 mm deep, 2 mm short of the rotator's (measured, SAPIEN one-move trial). At 125-128 deg
+    #: (pinch 20-28 mm deep) they reached 40 mm and met the rotator's fingers in the twist.
+    holder_thumb_flex: float = math.radians(121.0)
     #: the tool frame stands this far off the face's centre towards the thumb's root (m, tool +y). The
     #: corrected thumb's tip lands within 3.4 mm of the palm axis at both flexes: no offset needed.
     rotator_thumb_offset: float = 0.0
