@@ -128,6 +128,11 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
             believed_error > BELIEF_ERROR - 0.003
         )  # the hand did stop ~8 mm away from the believed grasp
         fixed, shift = reanchor_along_approach(belief, res.commanded, design)
+        print(  # the figures of docs/herb_push_grasp.md (pytest -s)
+            f"{backend} belief {sign * BELIEF_ERROR * 1e3:+.0f} mm: travel {res.travel * 1e3:.1f} mm, "
+            f"grasp depth error {grasp_error * 1e3:.2f} mm, belief after "
+            f"{abs(fixed.p[2] - true.p[2]) * 1e3:.2f} mm, stop force {res.force:.1f} N"
+        )
         assert abs(fixed.p[2] - true.p[2]) < 0.003
         assert abs(shift) == pytest.approx(BELIEF_ERROR, abs=0.003)
         assert (
@@ -209,7 +214,22 @@ def _herb_ctx(backend: str, sequence: str, seed: int = 0):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+@pytest.mark.parametrize(
+    "backend",
+    [
+        pytest.param(
+            "pybullet",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="corrected BarrettHand (issue 11): PyBullet's holder pinch meets the cube 17 mm "
+                "deep, on its outer slab only, so the middle slab turns with the rotator's layer "
+                "(+70.6 / -26.0 deg); a deeper pinch meets the rotator's fingertips in the twist or "
+                "blocks the Rubiks-1-5 hand-over takes (docs/herb_push_grasp.md)",
+            ),
+        ),
+        "sapien",
+    ],
+)
 def test_whole_one_move_trial_with_injected_errors(backend):
     """A whole trial (pick from the table, push-grasps, one twist by the physical cube, release) of ``R``.
 
@@ -242,9 +262,8 @@ def test_whole_one_move_trial_with_injected_errors(backend):
 def test_rubiks_1_5_through_the_cli_is_scored(tmp_path, backend):
     """`benchharness run --task Rubiks-1-5 --robot herb --strategy push-grasp`: runs, is stored and scored.
 
-    On SAPIEN the whole trial succeeds: all 5 moves as intended, the final state checked by the protocol
-    validator. On PyBullet it still fails (a physical cause, no strategy or simulator error); see
-    docs/herb_push_grasp.md for the measured outcomes.
+    On both engines the whole trial succeeds on the corrected HERB (issue 11): all 5 moves as intended,
+    the final state checked by the protocol validator (docs/herb_push_grasp.md, measured outcomes).
     """
     import json
 
@@ -285,10 +304,9 @@ def test_rubiks_1_5_through_the_cli_is_scored(tmp_path, backend):
     assert res.returncode == 0, res.stderr[-2000:]
     trials = json.loads(res.stdout)["trials"]
     assert len(trials) == 1
-    if backend == "sapien":
-        trial = trials[0]
-        assert trial["status"] == "success", trial
-        assert (
-            trial["diagnostics_counts"]["move"] == 5
-            and trial["diagnostics_counts"]["unintended_rotation"] == 0
-        )
+    trial = trials[0]
+    assert trial["status"] == "success", trial
+    assert (
+        trial["diagnostics_counts"]["move"] == 5
+        and trial["diagnostics_counts"]["unintended_rotation"] == 0
+    )

@@ -46,9 +46,12 @@ class HerbPushGraspConfig:
     #: the rotator's fingertips struck the holder's during the twist (51 N, the layer turned 62-73 deg).
     rotator_thumb_flex: float = math.radians(100.0)
     #: thumb flex of the holder's pre-shape (rad): tip 18.9 mm beyond the tool frame; its fingers meet
-    #: the sides 15-23 mm deep (across the 19 mm slab boundary: both held slabs) and their distal boxes
-    #: end ~35 mm deep, 2 mm short of the rotator's (measured, SAPIEN one-move trial). At 125-128 deg
-    #: (pinch 20-28 mm deep) they reached 40 mm and met the rotator's fingers in the twist.
+    #: the sides 15-23 mm deep on SAPIEN (F1/F2 differ: the held cube sits off the pinch centre and the
+    #: tips close on an arc), 17 mm on PyBullet, and their distal boxes end ~35 mm deep, 2 mm short of
+    #: the rotator's. The window is narrow (docs/herb_push_grasp.md): at 17 mm only the outer slab is
+    #: held (PyBullet one-move trial: the middle slab dragged 70 deg); at 122-123 deg the hand-over takes
+    #: found no grip that clears the giver's fingers (Rubiks-1-5 `unreachable` on both engines); at
+    #: 125-128 deg (pinch 20-28 mm) the fingertips reached 40 mm and met the rotator's in the twist.
     holder_thumb_flex: float = math.radians(121.0)
     #: the tool frame stands this far off the face's centre towards the thumb's root (m, tool +y). The
     #: corrected thumb's tip lands within 3.4 mm of the palm axis at both flexes: no offset needed.
