@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 from simhelpers import check_fk_against_backend, check_motion, offset_pose
 
 from benchharness.backends.interface import Box
@@ -39,6 +40,9 @@ def test_hand_grasps_and_lifts_cube(make_backend, make_robot, backend):
     robot = make_robot("herb")
     robot.spawn(be)
     arm, hand = robot.arm("left_arm"), robot.hand("left_hand")
+    # hand pointing straight down in front of the left shoulder (home points it 45 deg down)
+    down = Pose.from_rotation([0.85, 0.22, 0.95], Rotation.from_euler("y", np.pi))
+    assert arm.move_to_pose(down, seed=0).ik_success
     tcp = arm.tcp_pose()
     top = tcp.p[2] - CUBE_HALF
     be.add_body(
@@ -58,9 +62,13 @@ def test_hand_grasps_and_lifts_cube(make_backend, make_robot, backend):
     robot.settle(0.1)
     g = hand.close(obj=cube, timeout=1.0)
     assert g.contact and not g.closed
+    # the bent distal links draw the cube towards the palm as they close: let the grasp settle
+    robot.settle(0.5)
     c0 = be.get_pose(cube).p.copy()
     assert arm.move_to_pose(Pose(tcp.p + [0, 0, 0.10], tcp.q)).ik_success
     robot.settle(1.0)
     c1 = be.get_pose(cube).p
-    assert c1[2] - c0[2] == pytest.approx(0.10, abs=0.01)
+    # held: it rose with the hand (the bent distal links draw it up to 14 mm further towards the
+    # palm once the pedestal no longer carries it: measured 12-14 mm on both engines)
+    assert c1[2] - c0[2] == pytest.approx(0.10, abs=0.02)
     assert hand.touching(cube)

@@ -63,6 +63,7 @@ def test_push_grip_frames_against_hand_computed_ones():
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])
 def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_robot, backend):
     """Push-grasp a cube on a pedestal from above with the belief 8 mm off, both ways; check with the true pose."""
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
     from benchharness.strategies.herb_rubiks.frames import reanchor_along_approach, thumb_face_depth
     from benchharness.strategies.herb_rubiks.push import (
         close_outer_fingers,
@@ -75,7 +76,10 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
     robot = make_robot("herb")
     robot.spawn(be)
     arm, hand = robot.arm("left_arm"), robot.hand("left_hand")
-    home = arm.tcp_pose()  # pointing straight down
+    # pointing straight down in front of the left shoulder
+    down = Pose.from_rotation([0.85, 0.22, 0.95], Rotation.from_euler("y", np.pi))
+    assert arm.move_to_pose(down, seed=0).ik_success
+    home = arm.tcp_pose()
     top = home.p[2] - 0.09
     be.add_body(
         [Box((0.02, 0.02, (top - 2 * CUBE_HALF) / 2))],
@@ -91,7 +95,8 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
         friction=1.0,
         name="cube",
     )
-    preshape(hand, np.pi / 2, 0.55)
+    cfg = HerbPushGraspConfig()
+    preshape(hand, cfg.spread, cfg.rotator_thumb_flex, outer_flex=cfg.outer_open_flex)
     robot.settle(0.2)
     design = thumb_face_depth(arm.tcp_pose(), be.get_link_pose(robot.body, "l_bh_finger_33_link"))
     assert 0.025 < design < 0.04
@@ -123,6 +128,11 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
             believed_error > BELIEF_ERROR - 0.003
         )  # the hand did stop ~8 mm away from the believed grasp
         fixed, shift = reanchor_along_approach(belief, res.commanded, design)
+        print(  # the figures of docs/herb_push_grasp.md (pytest -s)
+            f"{backend} belief {sign * BELIEF_ERROR * 1e3:+.0f} mm: travel {res.travel * 1e3:.1f} mm, "
+            f"grasp depth error {grasp_error * 1e3:.2f} mm, belief after "
+            f"{abs(fixed.p[2] - true.p[2]) * 1e3:.2f} mm, stop force {res.force:.1f} N"
+        )
         assert abs(fixed.p[2] - true.p[2]) < 0.003
         assert abs(shift) == pytest.approx(BELIEF_ERROR, abs=0.003)
         assert (
@@ -131,7 +141,7 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
         close_outer_fingers(hand, 2.0)
         assert hand.touching(cube)
         u = hand.command.copy()
-        u[1] = u[2] = 0.0
+        u[1] = u[2] = cfg.outer_open_flex
         hand.set_command(u)
         robot.settle(0.4)
 
@@ -162,13 +172,17 @@ def test_hand_over_clearance_geometry():
     lo2, hi2 = finger_extent(
         Pose([0.0, 0.0, 0.0]), tool_meas, [(link, DIST_CORNERS)], Pose([0.0, 0.0, 0.0])
     )
-    assert np.allclose(lo2, [-0.011, -0.007, 0.053], atol=1e-9) and np.allclose(
-        hi2, [0.011, 0.007, 0.102], atol=1e-9
+    # the distal box (robots/descriptions/herb.py): x 3..50 mm along the link, y +-7 mm, z +-11 mm
+    assert np.allclose(lo2, [0.003, -0.007, 0.039], atol=1e-9) and np.allclose(
+        hi2, [0.05, 0.007, 0.061], atol=1e-9
     )
-    # thumb tip: a distal link curled 60 deg from the approach towards tool -y touches with its far end's
-    # corners on the approach side (link y = +7 mm): tool y = -52 mm sin 60 + 7 mm cos 60
-    distal = Pose.from_rotation([0.0, 0.0, 0.03], Rotation.from_euler("x", 60, degrees=True))
-    expect = -0.052 * np.sin(np.radians(60)) + 0.007 * np.cos(np.radians(60))
+    # thumb tip: a distal link (x along it) curled 60 deg from the approach towards tool -y, its
+    # closing side (link y) towards the approach, touches with its far end's corners on that side
+    # (x = 50 mm, y = +7 mm): tool y = -50 mm sin 60 + 7 mm cos 60
+    s60, c60 = np.sin(np.radians(60)), np.cos(np.radians(60))
+    cols = np.array([[0.0, -s60, c60], [0.0, c60, s60], [-1.0, 0.0, 0.0]]).T
+    distal = Pose.from_rotation([0.0, 0.0, 0.03], Rotation.from_matrix(cols))
+    expect = -0.05 * s60 + 0.007 * c60
     assert thumb_tip_lateral(Pose([0.0, 0.0, 0.0]), distal) == pytest.approx(expect, abs=1e-9)
 
 
@@ -200,7 +214,22 @@ def _herb_ctx(backend: str, sequence: str, seed: int = 0):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+@pytest.mark.parametrize(
+    "backend",
+    [
+        pytest.param(
+            "pybullet",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="corrected BarrettHand (issue 11): PyBullet's holder pinch meets the cube 17 mm "
+                "deep, on its outer slab only, so the middle slab turns with the rotator's layer "
+                "(+70.6 / -26.0 deg); a deeper pinch meets the rotator's fingertips in the twist or "
+                "blocks the Rubiks-1-5 hand-over takes (docs/herb_push_grasp.md)",
+            ),
+        ),
+        "sapien",
+    ],
+)
 def test_whole_one_move_trial_with_injected_errors(backend):
     """A whole trial (pick from the table, push-grasps, one twist by the physical cube, release) of ``R``.
 
@@ -233,9 +262,8 @@ def test_whole_one_move_trial_with_injected_errors(backend):
 def test_rubiks_1_5_through_the_cli_is_scored(tmp_path, backend):
     """`benchharness run --task Rubiks-1-5 --robot herb --strategy push-grasp`: runs, is stored and scored.
 
-    On SAPIEN the whole trial succeeds: all 5 moves as intended, the final state checked by the protocol
-    validator. On PyBullet it still fails (a physical cause, no strategy or simulator error); see
-    docs/herb_push_grasp.md for the measured outcomes.
+    On both engines the whole trial succeeds on the corrected HERB (issue 11): all 5 moves as intended,
+    the final state checked by the protocol validator (docs/herb_push_grasp.md, measured outcomes).
     """
     import json
 
@@ -276,10 +304,9 @@ def test_rubiks_1_5_through_the_cli_is_scored(tmp_path, backend):
     assert res.returncode == 0, res.stderr[-2000:]
     trials = json.loads(res.stdout)["trials"]
     assert len(trials) == 1
-    if backend == "sapien":
-        trial = trials[0]
-        assert trial["status"] == "success", trial
-        assert (
-            trial["diagnostics_counts"]["move"] == 5
-            and trial["diagnostics_counts"]["unintended_rotation"] == 0
-        )
+    trial = trials[0]
+    assert trial["status"] == "success", trial
+    assert (
+        trial["diagnostics_counts"]["move"] == 5
+        and trial["diagnostics_counts"]["unintended_rotation"] == 0
+    )

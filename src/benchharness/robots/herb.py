@@ -39,8 +39,10 @@ BARRETT_HAND_COUPLING = (
     (0.0, 0.0, 0.0, 1.0),
     (0.0, 0.0, 0.0, BH_COUPLING),
 )
-#: Arm home: upper arm forward-up, elbow bent, hand pointing forward-down in front of the torso.
-HOME_ARM = (0.0, 0.9, 0.0, 1.9, 0.0, 0.35, 0.0)
+#: Arm home (left; the right arm mirrors it, negating j1, j3, j5, j7 — the WAM's zero pose lies in
+#: the mirror plane): elbow folded, tool frame at (0.85, 0.22, 0.95) m pointing forward and 45 deg
+#: down (found by IK on the published mount; both WAMs are mounted alike, j1 along the base's +x).
+HOME_ARM = (0.318, -1.058, 0.241, 2.579, 0.629, -0.845, -0.614)
 
 
 def herb_config(
@@ -97,7 +99,11 @@ def herb_config(
         home=home,
         base_pose=base_pose or Pose(),
         summary="CMU HERB: two Barrett WAM 7-DOF arms with BarrettHand BH8-280 (base fixed)",
-        sources=("Barrett WAM manual DH parameters", "BarrettHand BH8-280 kinematics"),
+        sources=(
+            "Barrett WAM manual DH parameters",
+            "personalrobotics/herb_description@2604b90 (mounts, F/T plate, limits)",
+            "jhu-lcsr/barrett_model@b58cf4c (BarrettHand kinematics)",
+        ),
     )
     if urdf is not None:
         cfg = cfg.remapped(urdf, joint_map, link_map)

@@ -19,36 +19,44 @@ __all__ = ["ErrorConfig", "HerbPushGraspConfig"]
 class HerbPushGraspConfig:
     """Scene, pre-shapes, push and motion settings (metres, seconds, radians, newtons)."""
 
-    #: table top height (m): the cube's middle (0.9285 m) is a short reach below HERB's home hands
-    #: (1.03 m). Lower (0.80 m) the side pick needs WAM joint 2 at its 2.0 rad limit, where the arm sags
-    #: 2-3 cm under gravity.
+    #: table top height (m): the cube's middle at 0.9285 m, level with the WAM shoulders (j1 at
+    #: 0.9126 m, herb_description).
     table_height: float = 0.90
-    #: half extents (x, y) of the table top (m): narrow in y so that the picking palm and the
-    #: thumb's root pass beside it.
-    table_half_size: tuple[float, float] = (0.10, 0.04)
-    #: cube centre on the table, robot base frame (x forward, y left): between the two WAMs.
-    cube_xy: tuple[float, float] = (0.60, 0.0)
-    #: cube centre while twisting (robot base frame); both WAMs reach every push-grasp and hand-over
-    #: turn there (measured, SAPIEN, Rubiks-1-5 trial 1). 25 cm above the table top: at 10 cm a giver
-    #: turning the cube in front, pinch axis vertical, put a finger (75 mm off the palm axis at spread
-    #: 90 deg) on the table. 75 cm forward: nearer (58-68 cm) a giver in front needs WAM joint 2 at its
-    #: 2.0 rad limit, where link 3 meets link 1 and the arm stops 4-6 cm short.
-    twist_position: tuple[float, float, float] = (0.75, 0.0, 1.15)
+    #: half extents (x, y) of the table top (m): narrower in y than the cube (28.5 mm) so that the
+    #: picking palm and the thumb, whose flex axis is 50 mm off the palm axis, pass beside it (at
+    #: 0.04 m the holder's thumb struck the table edge, folded 14 deg and shoved the cube 6 mm).
+    table_half_size: tuple[float, float] = (0.10, 0.02)
+    #: cube centre on the table, robot base frame (x forward, y left): between the two WAMs, 0.55 m in
+    #: front of their j1 axes (x 0.351 m): nearer, the folded arms reach no side of the cube (an IK scan
+    #: of the push-grasp frames on the published mount, docs/herb_push_grasp.md).
+    cube_xy: tuple[float, float] = (0.90, 0.0)
+    #: cube centre while twisting (robot base frame): 20 cm above the table top, where the IK scan
+    #: finds push-grasps of every side but the far one (+x) for both arms (x 0.9 m, z 0.8-1.1 m).
+    twist_position: tuple[float, float, float] = (0.90, 0.0, 1.10)
     #: spread of F1/F2 (rad): 90 deg puts the outer fingers face to face across the tool x axis.
     spread: float = math.pi / 2
-    #: thumb (F3, the "middle finger") flex of the rotator's pre-shape (rad). Its tip then stands
-    #: ~33 mm beyond the tool frame: on contact the closing outer fingers (which pinch ~43 mm beyond
-    #: it) land ~10 mm deep, on the middle of the outer slab (0-19 mm).
-    rotator_thumb_flex: float = 0.55
-    #: thumb flex of the holder's pre-shape (rad): tip ~16 mm beyond the tool frame, pinch ~27 mm
-    #: deep, on the middle slab (19-38 mm); the holder's own outer slab is pressed by the thumb.
-    holder_thumb_flex: float = 0.70
-    #: the tool frame stands this far off the face's centre towards the thumb's root (m, tool +y), so
-    #: that the thumb's tip (which curls ~16 mm past the palm axis at the rotator's flex) meets the face
-    #: inside its edge. The holder's more flexed thumb curls ~29 mm past the axis: beyond the 28.5 mm
-    #: half face, so its hand sits 12 mm off centre.
+    #: flex of the open outer fingers F1/F2 in the pre-shape (rad; 0 = flat, radially out of the palm, the
+    #: published zero). 60 deg keeps their bent distal links 73 mm off the palm axis (clear of a 57 mm
+    #: cube's sides during the push) without spreading the hand 17 cm wide (docs/herb_push_grasp.md).
+    outer_open_flex: float = math.radians(60.0)
+    #: thumb (F3, the "middle finger") flex of the rotator's pre-shape (rad). From FK of the corrected
+    #: hand (docs/herb_push_grasp.md): the distal link's farthest corner stands 33.2 mm beyond the tool
+    #: frame, 14.7 mm past the palm axis; the closing outer fingers meet the cube's sides 3-7 mm deep
+    #: (measured), on the outer slab, their distal boxes reaching ~19 mm deep. Deeper (104 deg, 29.4 mm)
+    #: the rotator's fingertips struck the holder's during the twist (51 N, the layer turned 62-73 deg).
+    rotator_thumb_flex: float = math.radians(100.0)
+    #: thumb flex of the holder's pre-shape (rad): tip 18.9 mm beyond the tool frame; its fingers meet
+    #: the sides 15-23 mm deep on SAPIEN (F1/F2 differ: the held cube sits off the pinch centre and the
+    #: tips close on an arc), 17 mm on PyBullet, and their distal boxes end ~35 mm deep, 2 mm short of
+    #: the rotator's. The window is narrow (docs/herb_push_grasp.md): at 17 mm only the outer slab is
+    #: held (PyBullet one-move trial: the middle slab dragged 70 deg); at 122-123 deg the hand-over takes
+    #: found no grip that clears the giver's fingers (Rubiks-1-5 `unreachable` on both engines); at
+    #: 125-128 deg (pinch 20-28 mm) the fingertips reached 40 mm and met the rotator's in the twist.
+    holder_thumb_flex: float = math.radians(121.0)
+    #: the tool frame stands this far off the face's centre towards the thumb's root (m, tool +y). The
+    #: corrected thumb's tip lands within 3.4 mm of the palm axis at both flexes: no offset needed.
     rotator_thumb_offset: float = 0.0
-    holder_thumb_offset: float = 0.012
+    holder_thumb_offset: float = 0.0
     #: joint torque cap of the thumb while it probes (N m): stiff enough not to fold at the stop force.
     thumb_force: float = 2.0
     #: speed of the push along the face normal (m/s): slow, so the stop overshoots < 0.5 mm.
@@ -71,8 +79,8 @@ class HerbPushGraspConfig:
     #: on the same two faces the taker's closing fingers stalled on the giver's (2nd hand-over of Rubiks-1-5).
     handover_clearance: float = 0.003
     #: how far beyond the tool frame a closed outer finger reaches along the approach (m): the distal
-    #: box's tip, measured 48-49 mm on a 57 mm cube (SAPIEN, both depths).
-    finger_reach: float = 0.049
+    #: box's farthest corner when its inner side meets a 57 mm cube (flex ~86 deg, FK of the corrected hand).
+    finger_reach: float = 0.051
     #: half width of an outer finger across the palm (m): the proximal link box is 24 mm wide.
     finger_half_width: float = 0.012
     #: such a grip may slide across its face at most this far (m) from the face centre: the finger then

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
+from ...robots.descriptions.herb import DIST_BOX, PROX_BOX
 from ..pr2_rubiks.frames import DIRECTIONS, grip_candidates, rotate_about_point
 
 __all__ = [
@@ -43,28 +44,25 @@ __all__ = [
 CUBE_HALF = 0.0285
 #: rotation PR2 tool frame -> HERB tool frame (columns: HERB axes in PR2 tool coordinates)
 HERB_FROM_PR2 = Rotation.from_matrix(np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]))
-#: BarrettHand distal link box (robots/descriptions/herb.py: 22 x 14 mm, 49 mm long, from 3 mm past
-#: the distal joint), corners in the link frame
-_DIST_LEN = 0.055
-_DIST_CORNERS = np.array(
-    [
-        [sx * 0.011, sy * 0.007, 0.003 + sz]
-        for sx in (-1, 1)
-        for sy in (-1, 1)
-        for sz in (0.0, _DIST_LEN - 0.006)
-    ]
-)
-#: the same, public (distal links of any finger)
+
+
+def _box_corners(box) -> np.ndarray:
+    (sx, sy, sz), (cx, cy, cz) = box
+    return np.array(
+        [
+            [cx + a * sx / 2, cy + b * sy / 2, cz + c * sz / 2]
+            for a in (-1, 1)
+            for b in (-1, 1)
+            for c in (-1, 1)
+        ]
+    )
+
+
+#: BarrettHand distal and proximal link boxes (robots/descriptions/herb.py), corners in the link frame
+#: (x along the link, y its closing side, z the joint axis)
+_DIST_CORNERS = _box_corners(DIST_BOX)
 DIST_CORNERS = _DIST_CORNERS
-#: BarrettHand proximal link box (24 x 16 mm, 58 mm long, centred 37 mm past the flex joint), link frame
-PROX_CORNERS = np.array(
-    [
-        [sx * 0.012, sy * 0.008, 0.037 + sz * 0.029]
-        for sx in (-1, 1)
-        for sy in (-1, 1)
-        for sz in (-1, 1)
-    ]
-)
+PROX_CORNERS = _box_corners(PROX_BOX)
 
 
 def approach_axis(tool: Pose) -> np.ndarray:

@@ -82,10 +82,16 @@ def contact_force(robot, hand, obj, links: set[str] | None = None) -> tuple[floa
 
 
 def preshape(
-    hand, spread: float, thumb_flex: float, *, wait: float = 0.4, thumb_force: float = 2.0
+    hand,
+    spread: float,
+    thumb_flex: float,
+    *,
+    outer_flex: float = 0.0,
+    wait: float = 0.4,
+    thumb_force: float = 2.0,
 ) -> None:
-    """Open F1 and F2, set the spread, flex the thumb (F3) to ``thumb_flex`` rad: the probe."""
-    u = np.array([spread, 0.0, 0.0, thumb_flex])
+    """Open F1 and F2 to ``outer_flex``, set the spread, flex the thumb (F3) to ``thumb_flex`` rad: the probe."""
+    u = np.array([spread, outer_flex, outer_flex, thumb_flex])
     f = np.asarray(hand.config.force_limit, dtype=float).copy()
     # the thumb probes: its drive may push harder than a grasping finger so that it does not fold on contact
     for i, j in enumerate(hand.joints):

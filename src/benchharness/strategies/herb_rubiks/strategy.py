@@ -337,7 +337,13 @@ class PushGraspStrategy:
         """Spread 90 deg, outer fingers open, thumb flexed for ``depth``; measure how far the thumb reaches."""
         cfg = self.config
         flex = cfg.rotator_thumb_flex if depth == 1 else cfg.holder_thumb_flex
-        preshape(hand.gripper, cfg.spread, flex, thumb_force=cfg.thumb_force)
+        preshape(
+            hand.gripper,
+            cfg.spread,
+            flex,
+            outer_flex=cfg.outer_open_flex,
+            thumb_force=cfg.thumb_force,
+        )
         prefix = hand.arm.config.tcp_link.split("_")[0]
         distal = self.b.get_link_pose(self.robot.body, f"{prefix}_bh_finger_33_link")
         hand.face_depth = thumb_face_depth(hand.arm.tcp_pose(), distal)
@@ -751,7 +757,7 @@ class PushGraspStrategy:
 
     def _open_outer(self, hand: Hand, wait: float = 0.3) -> None:
         u = hand.gripper.command.copy()
-        u[1] = u[2] = 0.0
+        u[1] = u[2] = self.config.outer_open_flex
         hand.gripper.set_command(u)
         wait_fingers(hand.gripper, wait)
 
@@ -766,7 +772,7 @@ class PushGraspStrategy:
         vertical (giver in front) or the cube hangs below it (giver above).
         """
         u = hand.gripper.command.copy()
-        u[3] = 0.0
+        u[3] = math.pi / 2  # along the approach (0 is flat, radially out of the palm)
         hand.gripper.set_command(u, _force_limits(hand.gripper))
         wait_fingers(hand.gripper, 0.4)
         hand.shape = 0
