@@ -48,10 +48,16 @@ class Recorder:
         self.goals_outside_hard = 0
         self.goal_joints: Counter[str] = Counter()
         self.goal_callers: Counter[str] = Counter()
+        #: goals with a joint pinned on a soft limit (within 1e-6 rad; IK clamps there): where the limits bite
+        self.goals_at_soft = 0
+        self.at_soft: Counter[str] = Counter()  # "caller: joint lower|upper"
         self.targets = 0  # (tick, joint) pairs driven
         self.targets_outside_soft = 0
         self.target_joints: Counter[str] = Counter()
-        self.worst: dict[str, float] = {}  # joint -> largest excursion beyond the soft limit (rad)
+        self.worst: dict[
+            str, float
+        ] = {}  # joint -> largest goal excursion beyond the soft limit (rad)
+        self.worst_driven: dict[str, float] = {}  # the same for driven targets
 
     @staticmethod
     def _limits(robot, joints):
@@ -78,6 +84,14 @@ class Recorder:
                     self.worst[j] = max(self.worst.get(j, 0.0), float(max(lo - v, v - hi)))
         if ((q < hlo - TOL) | (q > hhi + TOL)).any():
             self.goals_outside_hard += 1
+        hard_differs = (slo > hlo) | (shi < hhi)
+        at_lo = hard_differs & (np.abs(q - slo) < 1e-6)
+        at_hi = hard_differs & (np.abs(q - shi) < 1e-6)
+        if (at_lo | at_hi).any():
+            self.goals_at_soft += 1
+            for j, lo_, hi_ in zip(arm.joints, at_lo, at_hi):
+                if lo_ or hi_:
+                    self.at_soft[f"{caller}: {j} {'lower' if lo_ else 'upper'}"] += 1
 
     def drive(self, robot, joints, q) -> None:
         import numpy as np
@@ -92,9 +106,11 @@ class Recorder:
         out = (v < slo - TOL) | (v > shi + TOL)
         self.targets += len(sel)
         self.targets_outside_soft += int(out.sum())
-        for j, o in zip(names, out):
+        for j, o, x, lo, hi in zip(names, out, v, slo, shi):
             if o:
                 self.target_joints[j] += 1
+                e = float(max(lo - x, x - hi))
+                self.worst_driven[j] = max(self.worst_driven.get(j, 0.0), e)
 
     def report(self) -> dict:
         return {
@@ -104,9 +120,14 @@ class Recorder:
             "goals_outside_soft_by_joint": dict(self.goal_joints.most_common()),
             "goals_outside_soft_by_caller": dict(self.goal_callers.most_common()),
             "worst_excursion_rad": {k: round(v, 4) for k, v in sorted(self.worst.items())},
+            "arm_goals_at_a_soft_limit": self.goals_at_soft,
+            "at_soft_limit_by_caller_and_joint": dict(self.at_soft.most_common()),
             "driven_arm_targets": self.targets,
             "driven_arm_targets_outside_soft": self.targets_outside_soft,
             "driven_outside_soft_by_joint": dict(self.target_joints.most_common()),
+            "worst_driven_excursion_rad": {
+                k: round(v, 4) for k, v in sorted(self.worst_driven.items())
+            },
         }
 
 
@@ -161,6 +182,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--soft-limits", choices=("on", "off"), default="on")
     ap.add_argument("--json", type=Path, help="also write the report here")
+    ap.add_argument(
+        "--store",
+        type=Path,
+        help="keep the trials in this results store (default: a temporary one)",
+    )
     args = ap.parse_args(argv)
 
     from benchharness.runner import ResultsStore, RunSpec, run_sweep
@@ -172,7 +198,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        store = ResultsStore(Path(tmp) / "bench.sqlite")
+        store = ResultsStore(args.store or Path(tmp) / "bench.sqlite")
         run = run_sweep(spec, store, workers=0)
         store.close()
     recs = run.records
