@@ -546,6 +546,19 @@ def test_move_to_joints_stops_at_the_soft_limit(make_backend, make_robot):
     res = arm.move_to_joints(goal, duration=2.0)
     assert res.q_goal[1] == pytest.approx(1.3963 - 0.10)
     assert arm.positions()[1] == pytest.approx(1.2963, abs=0.02)
+    # from a pose beyond the soft limit (as after a push), every PD target the move sends is inside
+    q = arm.positions().copy()
+    q[1] = 1.35
+    be.set_joint_positions(pr2.body, q, joints=list(arm.joints))
+    sent = []
+    drive = pr2.drive
+    pr2.drive = lambda joints, qq, qd=None: (sent.append(np.array(qq)), drive(joints, qq, qd))[1]
+    goal[1] = 1.0
+    arm.move_to_joints(goal, duration=1.0, settle=0.0)
+    lifts = [
+        t[list(arm.joints).index("l_shoulder_lift_joint")] for (t,) in zip(sent) if len(t) == 7
+    ]
+    assert lifts and max(lifts) <= 1.2963 + 1e-9
 
 
 # -- Allegro --------------------------------------------------------------------------------------
