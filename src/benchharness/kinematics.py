@@ -290,7 +290,18 @@ class _SerialModel:
 class KinematicChain:
     """A serial chain ``root_link`` -> ``tip_link`` of a URDF (e.g. one arm, one finger)."""
 
-    def __init__(self, urdf: str | Path, root_link: str, tip_link: str) -> None:
+    def __init__(
+        self,
+        urdf: str | Path,
+        root_link: str,
+        tip_link: str,
+        limits: Mapping[str, tuple[float, float]] | None = None,
+    ) -> None:
+        """``limits``: joint -> (lower, upper) replacing the URDF's, e.g. a robot's soft limits.
+
+        Every search, sample and clamp of the chain (NumPy and pytorch-kinematics
+        solver alike) then stays inside them.
+        """
         text = _read(urdf)
         self.root_link = root_link
         self.tip_link = tip_link
@@ -299,8 +310,13 @@ class KinematicChain:
         ).to(dtype=DTYPE)
         self.joint_names: list[str] = list(self.chain.get_joint_parameter_names(exclude_fixed=True))
         low, high = self.chain.get_joint_limits()
-        self.lower = np.asarray(low, dtype=float)
-        self.upper = np.asarray(high, dtype=float)
+        self.lower = np.array(low, dtype=float)
+        self.upper = np.array(high, dtype=float)
+        for name, (lo, hi) in (limits or {}).items():
+            k = self.joint_names.index(name)
+            if not lo < hi:
+                raise ValueError(f"joint {name}: limits {lo}..{hi} are empty")
+            self.lower[k], self.upper[k] = lo, hi
         # Continuous joints (e.g. a full pr2_description's forearm/wrist roll) are searched over
         # [-pi, pi]: every angle is reachable there, and IK needs finite bounds to sample and clamp.
         unbounded = ~(np.isfinite(self.lower) & np.isfinite(self.upper)) | (
@@ -308,6 +324,7 @@ class KinematicChain:
         )
         if unbounded.any():
             self.lower[unbounded], self.upper[unbounded] = -np.pi, np.pi
+        if unbounded.any() or limits:
             self.chain.low = torch.as_tensor(self.lower, dtype=DTYPE)
             self.chain.high = torch.as_tensor(self.upper, dtype=DTYPE)
         self._np: _SerialModel | None = None

@@ -80,13 +80,17 @@ def test_both_engines_drive_the_rolls_past_two_pi(make_backend, make_robot, back
 @pytest.mark.sim
 @pytest.mark.parametrize("backend", ("pybullet", "sapien"))
 def test_full_wrist_flex_is_free_of_self_collision(make_backend, make_robot, backend):
-    """The palm clears the forearm over the whole -2.094..0 rad wrist flex at any wrist roll."""
+    """The palm clears the forearm over the whole hard wrist-flex range (-2.18..0 rad) at any wrist roll."""
     be = make_backend(backend)
     robot = make_robot("pr2")
     robot.spawn(be)
     arm = robot.arm("left_arm")
     names = list(arm.joints)
-    for flex in np.linspace(0.0, -2.094, 8):
+    hard = robot.urdf_joints["l_wrist_flex_joint"]
+    assert (
+        hard.lower == -2.18
+    )  # pr2_description forearm_v0/forearm.urdf.xacro (PR2/pr2_common@c36a5c9c)
+    for flex in np.linspace(0.0, hard.lower, 8):
         for roll in (0.0, np.pi / 4, np.pi / 2):
             q = arm.positions().copy()
             q[5], q[6] = flex, roll

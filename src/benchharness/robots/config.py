@@ -104,6 +104,10 @@ class RobotConfig:
     fixed_base: bool = True
     summary: str = ""
     sources: tuple[str, ...] = ()  #: where the figures come from (README has the detail)
+    #: IK and every motion primitive keep joints inside the URDF's ``<safety_controller>`` soft limits
+    #: (the PR2's: a few tenths of a radian inside the hard limits). Joints without one keep their hard
+    #: limits, so a robot with none (HERB, Allegro) is unaffected; False: hard limits everywhere.
+    soft_limits: bool = True
 
     def groups(self) -> dict[str, tuple[str, ...]]:
         g: dict[str, tuple[str, ...]] = {a.name: a.joints for a in self.arms}

@@ -1,4 +1,9 @@
-"""Joint facts read from a URDF before any backend is involved (limits, velocities, efforts)."""
+"""Joint facts read from a URDF before any backend is involved (limits, velocities, efforts).
+
+Soft limits come from a joint's ``<safety_controller soft_lower_limit
+soft_upper_limit>`` (as ``pr2_description`` writes them); a joint without one
+has its hard limits as soft limits.
+"""
 
 from __future__ import annotations
 
@@ -22,6 +27,9 @@ class UrdfJoint:
     upper: float
     velocity: float
     effort: float
+    soft_lower: float = -math.inf  #: ``<safety_controller soft_lower_limit>``, else ``lower``
+    soft_upper: float = math.inf  #: ``<safety_controller soft_upper_limit>``, else ``upper``
+    has_soft_limits: bool = False  #: the URDF gives this joint a soft position range
 
 
 def read_joints(urdf: str | Path) -> list[UrdfJoint]:
@@ -39,6 +47,15 @@ def read_joints(urdf: str | Path) -> list[UrdfJoint]:
             lo, hi = float(lim.get("lower", 0.0)), float(lim.get("upper", 0.0))
         else:
             lo, hi = 0.0, 0.0
+        sc = j.find("safety_controller")
+        soft = (
+            sc is not None
+            and sc.get("soft_lower_limit") is not None
+            and sc.get("soft_upper_limit") is not None
+        )
+        # a soft limit never widens the hard range
+        slo = max(lo, float(sc.get("soft_lower_limit"))) if soft else lo
+        shi = min(hi, float(sc.get("soft_upper_limit"))) if soft else hi
         out.append(
             UrdfJoint(
                 j.get("name"),
@@ -49,6 +66,9 @@ def read_joints(urdf: str | Path) -> list[UrdfJoint]:
                 hi,
                 float(lim.get("velocity", math.inf)) if lim is not None else math.inf,
                 float(lim.get("effort", math.inf)) if lim is not None else math.inf,
+                slo,
+                shi,
+                bool(soft),
             )
         )
     return out

@@ -109,6 +109,9 @@ def pr2_config(
         base_pose=base_pose or Pose(),
         summary="Willow Garage PR2: torso lift, two 7-DOF arms, two parallel grippers (base fixed)",
         sources=("PR2/pr2_common pr2_description xacros",),
+        # IK and the primitives stay inside the safety controller's soft limits, which the URDF carries
+        # (descriptions.pr2.SAFETY); a full pr2_description URDF carries the same elements.
+        soft_limits=True,
     )
     if urdf is not None:
         cfg = cfg.remapped(urdf, joint_map, link_map)

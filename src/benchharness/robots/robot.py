@@ -84,21 +84,33 @@ class Robot:
         out.update({g.name: g.config.tcp_link for g in self.grippers.values() if g.config.tcp_link})
         return out
 
+    def joint_limits(self, joints: Sequence[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The position limits that IK and every motion primitive keep ``joints`` (default: all) within.
+
+        The URDF's soft limits (``<safety_controller>``, e.g. the PR2's) when
+        ``config.soft_limits``, else, and for joints without them, the hard
+        ``<limit>``; continuous joints are unbounded (inf). Why soft limits:
+        the real robot's safety controller resists poses beyond them, so a
+        strategy that needs one would not run on it.
+        """
+        names = self.joint_names if joints is None else list(joints)
+        js = [self.urdf_joints[n] for n in names]
+        if self.config.soft_limits:
+            return np.array([j.soft_lower for j in js]), np.array([j.soft_upper for j in js])
+        return np.array([j.lower for j in js]), np.array([j.upper for j in js])
+
     def home(self) -> np.ndarray:
         """Home configuration in :attr:`joint_names` order.
 
         Joints the config's ``home`` does not name take their gripper's open
-        position, or 0; all are clamped to limits.
+        position, or 0; all are clamped to :meth:`joint_limits`.
         """
         default: dict[str, float] = {}
         for g in self.grippers.values():
             default.update(zip(g.joints, g.config.joint_targets(g.config.open)))
-        q = []
-        for n in self.joint_names:
-            j = self.urdf_joints[n]
-            v = float(self.config.home.get(n, default.get(n, 0.0)))
-            q.append(min(max(v, j.lower), j.upper))
-        return np.array(q)
+        lo, hi = self.joint_limits()
+        q = [float(self.config.home.get(n, default.get(n, 0.0))) for n in self.joint_names]
+        return np.clip(np.array(q), lo, hi)
 
     def describe(self) -> dict:
         return {

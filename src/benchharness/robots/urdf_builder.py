@@ -8,6 +8,16 @@ diagonalised and written as principal moments plus an ``<inertial>`` rpy,
 because PyBullet ignores off-diagonal terms while SAPIEN honours them — a
 diagonal tensor in a rotated frame means the same thing to both.
 
+Where a robot's description publishes a link's inertial (centre of mass
+and full tensor), :class:`Link` takes it as is (``com``, ``inertia``) instead
+of computing one from the stand-in shapes, whose centres can lie centimetres
+from the real COM; it is still written diagonalised, for the same reason.
+
+Joints may carry soft limits (``soft_lower``/``soft_upper``), written as a
+``<safety_controller>`` element as in ``pr2_description``: the position
+limits that IK and the motion primitives respect, inside the hard
+``<limit>`` that the engines enforce.
+
 Every figure carries a ``source`` string that is written as an XML comment,
 so the generated file says where each number came from.
 """
@@ -136,6 +146,10 @@ class Link:
     mass: float = 0.0
     source: str = ""
     point_mass_radius: float | None = None
+    #: published centre of mass (link frame); with ``inertia``, replaces the one computed from ``geoms``
+    com: tuple[float, float, float] | None = None
+    #: published inertia about ``com`` in link axes: (ixx, ixy, ixz, iyy, iyz, izz)
+    inertia: tuple[float, float, float, float, float, float] | None = None
 
     def xml(self) -> str:
         out = []
@@ -145,8 +159,14 @@ class Link:
         geoms = self.geoms
         if self.mass <= 0 and not geoms:
             self.mass, self.point_mass_radius = FRAME_MASS, FRAME_RADIUS
+        if (self.com is None) != (self.inertia is None):
+            raise ValueError(f"link {self.name}: give both com and inertia, or neither")
         if self.mass > 0:
-            if geoms:
+            if self.com is not None and self.inertia is not None:
+                xx, xy, xz, yy, yz, zz = self.inertia
+                com = np.asarray(self.com, dtype=float)
+                inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+            elif geoms:
                 com, inertia = composite_inertia(geoms, self.mass)
             elif self.point_mass_radius:
                 g = Geom("sphere", (self.point_mass_radius,))
@@ -193,6 +213,13 @@ class Joint:
     velocity: float = 0.0
     damping: float = 0.0
     source: str = ""
+    #: soft position limits (``<safety_controller>``), inside ``lower``/``upper``; None: none
+    soft_lower: float | None = None
+    soft_upper: float | None = None
+    k_position: float = (
+        0.0  #: safety-controller gains, written as published (not used by the harness)
+    )
+    k_velocity: float = 0.0
 
     def xml(self) -> str:
         out = []
@@ -208,6 +235,16 @@ class Joint:
             if self.type != "continuous":
                 lim = f'lower="{_f(self.lower)}" upper="{_f(self.upper)}" ' + lim
             out.append(f"    <limit {lim}/>")
+            if (self.soft_lower is None) != (self.soft_upper is None):
+                raise ValueError(f"joint {self.name}: give both soft limits, or neither")
+            if self.soft_lower is not None and self.soft_upper is not None:
+                if not self.lower <= self.soft_lower < self.soft_upper <= self.upper:
+                    raise ValueError(f"joint {self.name}: soft limits outside the hard limits")
+                out.append(
+                    f'    <safety_controller k_position="{_f(self.k_position)}" '
+                    f'k_velocity="{_f(self.k_velocity)}" soft_lower_limit="{_f(self.soft_lower)}" '
+                    f'soft_upper_limit="{_f(self.soft_upper)}"/>'
+                )
             if self.damping:
                 out.append(f'    <dynamics damping="{_f(self.damping)}" friction="0"/>')
         out.append("  </joint>")

@@ -1,11 +1,20 @@
 """PR2: mobile base (fixed), torso lift, two 7-DOF arms, two parallel grippers.
 
-Joint origins, axes, limits and link masses are those of the Willow Garage
-``pr2_description`` xacros (github.com/PR2/pr2_common, files named in each
-comment); velocity limits there are ``VELOCITY_LIMIT_SCALE * v`` with the
-scale 0.6 from ``pr2_description/urdf/common.xacro``. Collision shapes are
-primitive stand-ins for the meshes, sized to keep non-adjacent links apart
-in the home pose.
+Joint origins, axes, limits, soft limits, link masses, centres of mass and
+inertia tensors are those of the Willow Garage ``pr2_description`` xacros
+(github.com/PR2/pr2_common at commit c36a5c9c8d5e97d2d53a7c75fa57a3257a7c63cc,
+files named in each comment); velocity limits there are
+``VELOCITY_LIMIT_SCALE * v`` with the scale 0.6 from
+``pr2_description/urdf/common.xacro``. Collision shapes are primitive
+stand-ins for the meshes, sized to keep non-adjacent links apart in the home
+pose; the inertials are the published ones, not the shapes' (a shape's
+centre lies up to 16 cm from the real COM).
+
+Soft limits: the real PR2's safety controller keeps every arm joint and the
+torso inside ``<safety_controller soft_lower_limit/soft_upper_limit>``, a few
+tenths of a radian inside the hard ``<limit>``. Both are written here as
+published; the harness's IK and motion primitives respect the soft limits
+(``RobotConfig.soft_limits``), the engines the hard ones.
 
 Simplifications (also in robots/pr2/README.md):
 * the gripper is two prismatic fingers (the real one is a four-bar linkage
@@ -25,8 +34,41 @@ import math
 
 from ..urdf_builder import Geom, UrdfModel
 
+PR2_COMMIT = (
+    "c36a5c9c8d5e97d2d53a7c75fa57a3257a7c63cc"  #: PR2/pr2_common commit the figures are read at
+)
 PR2_SRC = "PR2/pr2_common pr2_description"
 VSCALE = 0.6  # VELOCITY_LIMIT_SCALE, pr2_description/urdf/common.xacro
+
+#: ``<safety_controller>`` of each limited joint: (soft margin above the hard lower limit, soft margin below
+#: the hard upper limit, k_position, k_velocity), as written in pr2_description: shoulder_v0/shoulder.urdf.xacro
+#: (pan ``+-0.15``, lift ``-0.5236+0.17`` / ``1.3963-0.10``, upper-arm roll ``+-0.15``),
+#: upper_arm_v0/upper_arm.urdf.xacro (elbow ``-2.3213+0.2`` / ``0.00-0.15``), forearm_v0/forearm.urdf.xacro
+#: (wrist flex ``-2.18+0.18`` / ``0.0-0.10``), torso_v0/torso.urdf.xacro (``0.0+0.0115`` / ``0.33-0.005``).
+#: Forearm and wrist roll are continuous: their safety controllers limit velocity only.
+SAFETY: dict[str, tuple[float, float, float, float]] = {
+    "shoulder_pan": (0.15, 0.15, 100.0, 10.0),
+    "shoulder_lift": (0.17, 0.10, 100.0, 10.0),
+    "upper_arm_roll": (0.15, 0.15, 100.0, 2.0),
+    "elbow_flex": (0.2, 0.15, 100.0, 3.0),
+    "wrist_flex": (0.18, 0.10, 20.0, 4.0),
+    "torso_lift": (0.0115, 0.005, 100.0, 2000000.0),
+}
+WRIST_FLEX_LOWER = -2.18  # rad, l_wrist_flex_joint limit lower (forearm_v0/forearm.urdf.xacro)
+
+
+def _soft(key: str, lower: float, upper: float) -> dict[str, float]:
+    """Joint keyword arguments for the published soft limits of joint ``key`` with hard ``lower..upper``."""
+    lo, hi, kp, kv = SAFETY[key]
+    return {
+        "lower": lower,
+        "upper": upper,
+        "soft_lower": round(lower + lo, 10),
+        "soft_upper": round(upper - hi, 10),
+        "k_position": kp,
+        "k_velocity": kv,
+    }
+
 
 #: Gripper figures.
 GRIPPER_MAX_OPENING = (
@@ -43,6 +85,29 @@ TCP_X = 0.18  # m; l_gripper_tool_frame origin xyz="0.18 0 0" (pr2_description g
 FINGER_X = 0.07691  # m; l_gripper_l_finger_joint origin x (gripper_v0/gripper.urdf.xacro)
 
 
+#: Upper-arm COM and inertia, which pr2_description gives per side (``ual_*`` left, ``uar_*`` right,
+#: upper_arm_v0/upper_arm.urdf.xacro).
+UPPER_ARM_COM = {"l": (0.21405, 0.01658, -0.00057), "r": (0.21398, -0.01621, -0.00020)}
+UPPER_ARM_INERTIA = {
+    "l": (
+        0.01530603856,
+        -0.00339324862,
+        0.00060765455,
+        0.07473694455,
+        -0.00019953729,
+        0.07601594191,
+    ),
+    "r": (
+        0.01537748957,
+        0.00375711247,
+        -0.00070852914,
+        0.07473670440,
+        -0.00017936450,
+        0.07608763307,
+    ),
+}
+
+
 def _arm(m: UrdfModel, side: str) -> None:
     reflect = 1 if side == "l" else -1
     s = side
@@ -54,19 +119,28 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_shoulder_pan_link",
         xyz=(0.0, reflect * 0.188, 0.0),
         axis=(0, 0, 1),
-        lower=reflect * math.pi / 4 - 1.5,
-        upper=reflect * math.pi / 4 + 1.5,
+        **_soft("shoulder_pan", reflect * math.pi / 4 - 1.5, reflect * math.pi / 4 + 1.5),
         effort=30,
         velocity=VSCALE * 3.48,
         damping=10.0,
-        source=f"origin 0 +-0.188 0 (pr2_description/urdf/arm_v0 / pr2.urdf.xacro); limits reflect*pi/4 +- 1.5, "
-        f"effort 30, velocity 0.6*3.48 ({src} shoulder_v0/shoulder.urdf.xacro)",
+        source=f"origin 0 +-0.188 0 (pr2_description/robots/pr2.urdf.xacro); limits reflect*pi/4 +- 1.5, "
+        f"soft limits 0.15 inside, effort 30, velocity 0.6*3.48 ({src} shoulder_v0/shoulder.urdf.xacro)",
     )
     m.link(
         f"{s}_shoulder_pan_link",
         [Geom("cylinder", (0.06, 0.30), (0.0, 0.0, -0.10))],
         25.799322,
-        source="mass 25.799322 kg, COM z -0.098 (shoulder_v0/shoulder.urdf.xacro); cylinder stands in for the shoulder mesh",
+        com=(-0.001201, 0.024513, -0.098231),
+        inertia=(
+            0.866179142480,
+            -0.06086507933,
+            -0.12118061183,
+            0.87421714893,
+            -0.05886609911,
+            0.27353821674,
+        ),
+        source="mass, COM and inertia as published, the same for both sides (shoulder_v0/shoulder.urdf.xacro); "
+        "cylinder stands in for the shoulder mesh",
     )
     m.joint(
         f"{s}_shoulder_lift_joint",
@@ -75,18 +149,27 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_shoulder_lift_link",
         xyz=(0.1, 0.0, 0.0),
         axis=(0, 1, 0),
-        lower=-0.5236,
-        upper=1.3963,
+        **_soft("shoulder_lift", -0.5236, 1.3963),
         effort=30,
         velocity=VSCALE * 3.47,
         damping=10.0,
-        source="origin 0.1 0 0, axis y, limits -0.5236..1.3963, effort 30, velocity 0.6*3.47 (shoulder_v0/shoulder.urdf.xacro)",
+        source="origin 0.1 0 0, axis y, limits -0.5236..1.3963, soft -0.3536..1.2963, effort 30, velocity 0.6*3.47 "
+        "(shoulder_v0/shoulder.urdf.xacro)",
     )
     m.link(
         f"{s}_shoulder_lift_link",
         [Geom("sphere", (0.06,))],
         2.74988,
-        source="mass 2.74988 kg (shoulder_v0/shoulder.urdf.xacro)",
+        com=(0.02195, -0.02664, -0.03127),
+        inertia=(
+            0.02105584615,
+            0.00496704022,
+            -0.00194808955,
+            0.02127223737,
+            0.00110425490,
+            0.01975753814,
+        ),
+        source="mass, COM and inertia as published (shoulder_v0/shoulder.urdf.xacro)",
     )
     m.joint(
         f"{s}_upper_arm_roll_joint",
@@ -94,18 +177,19 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_shoulder_lift_link",
         f"{s}_upper_arm_roll_link",
         axis=(1, 0, 0),
-        lower=reflect * 1.55 - 2.35,
-        upper=reflect * 1.55 + 2.35,
+        **_soft("upper_arm_roll", reflect * 1.55 - 2.35, reflect * 1.55 + 2.35),
         effort=30,
         velocity=VSCALE * 5.45,
         damping=0.1,
-        source="origin 0, axis x, limits reflect*1.55 +- 2.35, effort 30, velocity 0.6*5.45 (shoulder_v0/shoulder.urdf.xacro)",
+        source="origin 0, axis x, limits reflect*1.55 +- 2.35, soft limits 0.15 inside, effort 30, velocity 0.6*5.45 "
+        "(shoulder_v0/shoulder.urdf.xacro)",
     )
     m.link(
         f"{s}_upper_arm_roll_link",
         mass=0.1,
         point_mass_radius=0.02,
-        source="0.1 kg placeholder mass as in pr2_description (upper_arm_roll_link); inertia of a 2 cm solid sphere",
+        source="0.1 kg placeholder mass at the origin as in pr2_description (upper_arm_roll_link, 'dummy mass, "
+        "to be removed'); inertia of a 2 cm solid sphere, not the placeholder 0.01 kg m^2",
     )
     m.joint(
         f"{s}_upper_arm_joint",
@@ -118,7 +202,10 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_upper_arm_link",
         [Geom("box", (0.21, 0.09, 0.09), (0.175, 0.0, 0.0))],
         6.01769,
-        source="mass 6.01769 kg (upper_arm_v0/upper_arm.urdf.xacro); box x 0.07..0.28 m of the 0.4 m upper arm "
+        com=UPPER_ARM_COM[s],
+        inertia=UPPER_ARM_INERTIA[s],
+        source="mass 6.01769 kg, COM and inertia as published for this side (ual_*/uar_*, "
+        "upper_arm_v0/upper_arm.urdf.xacro); box x 0.07..0.28 m of the 0.4 m upper arm "
         "(ends 0.12 m short of the elbow so that the full -2.32 rad elbow flex is collision-free)",
     )
     m.joint(
@@ -128,18 +215,27 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_elbow_flex_link",
         xyz=(0.4, 0.0, 0.0),
         axis=(0, 1, 0),
-        lower=-2.3213,
-        upper=0.0,
+        **_soft("elbow_flex", -2.3213, 0.0),
         effort=30,
         velocity=VSCALE * 5.5,
         damping=1.0,
-        source="origin 0.4 0 0, axis y, limits -2.3213..0, effort 30, velocity 0.6*5.5 (upper_arm_v0/upper_arm.urdf.xacro)",
+        source="origin 0.4 0 0, axis y, limits -2.3213..0, soft -2.1213..-0.15, effort 30, velocity 0.6*5.5 "
+        "(upper_arm_v0/upper_arm.urdf.xacro)",
     )
     m.link(
         f"{s}_elbow_flex_link",
         [Geom("sphere", (0.05,))],
         1.90327,
-        source="mass 1.90327 kg (upper_arm_v0/upper_arm.urdf.xacro)",
+        com=(0.01014, 0.00032, -0.01211),
+        inertia=(
+            0.00346541989,
+            0.00004066825,
+            0.00043171614,
+            0.00441606455,
+            -0.00003968914,
+            0.00359156824,
+        ),
+        source="mass, COM and inertia as published (upper_arm_v0/upper_arm.urdf.xacro)",
     )
     m.joint(
         f"{s}_forearm_roll_joint",
@@ -156,7 +252,8 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_forearm_roll_link",
         mass=0.1,
         point_mass_radius=0.02,
-        source="0.1 kg placeholder mass as in pr2_description; inertia of a 2 cm solid sphere",
+        source="0.1 kg placeholder mass at the origin as in pr2_description ('dummy masses, to be removed'); "
+        "inertia of a 2 cm solid sphere, not the placeholder 0.01 kg m^2",
     )
     m.joint(
         f"{s}_forearm_joint",
@@ -169,8 +266,17 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_forearm_link",
         [Geom("box", (0.12, 0.08, 0.08), (0.18, 0.0, 0.0))],
         2.57968,
-        source="mass 2.57968 kg, COM x 0.188 (forearm_v0/forearm.urdf.xacro); box x 0.12..0.24 m "
-        "(ends 0.081 m short of the wrist flex axis, where the real forearm tapers, so that the full -2.094 rad "
+        com=(0.18791, -0.00017, -0.00912),
+        inertia=(
+            0.00364857222,
+            0.00005215877,
+            0.00071534842,
+            0.01507736897,
+            -0.00001310770,
+            0.01659310749,
+        ),
+        source="mass, COM and inertia as published (forearm_v0/forearm.urdf.xacro); box x 0.12..0.24 m "
+        "(ends 0.081 m short of the wrist flex axis, where the real forearm tapers, so that the full -2.18 rad "
         "wrist flex is collision-free with the palm at any wrist roll)",
     )
     m.joint(
@@ -180,18 +286,27 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_wrist_flex_link",
         xyz=(0.321, 0.0, 0.0),
         axis=(0, 1, 0),
-        lower=-2.094,
-        upper=0.0,
+        **_soft("wrist_flex", WRIST_FLEX_LOWER, 0.0),
         effort=10,
         velocity=VSCALE * 5.13,
         damping=0.1,
-        source="origin 0.321 0 0, axis y, limits -2.094..0, effort 10, velocity 0.6*5.13 (forearm_v0/forearm.urdf.xacro)",
+        source="origin 0.321 0 0, axis y, limits -2.18..0, soft -2.0..-0.1, effort 10, velocity 0.6*5.13 "
+        "(forearm_v0/forearm.urdf.xacro)",
     )
     m.link(
         f"{s}_wrist_flex_link",
         [Geom("sphere", (0.035,))],
         0.61402,
-        source="mass 0.61402 kg (forearm_v0/forearm.urdf.xacro)",
+        com=(-0.00157, 0.0, -0.00075),
+        inertia=(
+            0.00065165722,
+            0.00000028864,
+            0.00000303477,
+            0.00019824443,
+            -0.00000022645,
+            0.00064450498,
+        ),
+        source="mass, COM and inertia as published (forearm_v0/forearm.urdf.xacro)",
     )
     m.joint(
         f"{s}_wrist_roll_joint",
@@ -208,7 +323,8 @@ def _arm(m: UrdfModel, side: str) -> None:
         f"{s}_wrist_roll_link",
         mass=0.1,
         point_mass_radius=0.02,
-        source="0.1 kg placeholder mass as in pr2_description; inertia of a 2 cm solid sphere",
+        source="0.1 kg placeholder mass at the origin as in pr2_description ('dummy masses, to be removed'); "
+        "inertia of a 2 cm solid sphere, not the placeholder 0.01 kg m^2",
     )
     _gripper(m, s)
 
@@ -225,7 +341,17 @@ def _gripper(m: UrdfModel, s: str) -> None:
         f"{s}_gripper_palm_link",
         [Geom("box", (0.06, 0.07, 0.05), (0.08, 0.0, 0.0))],
         0.58007,
-        source="mass 0.58007 kg (gripper_v0/gripper.urdf.xacro); box x 0.05..0.11 m stands in for the palm mesh",
+        com=(0.06623, 0.00053, -0.00119),
+        inertia=(
+            0.00035223921,
+            -0.00001580476,
+            -0.00000091750,
+            0.00067741312,
+            -0.00000059554,
+            0.00086563316,
+        ),
+        source="mass, COM and inertia as published (gripper_v0/gripper.urdf.xacro); box x 0.05..0.11 m stands in "
+        "for the palm mesh",
     )
     m.joint(
         f"{s}_gripper_tcp_joint",
@@ -268,6 +394,7 @@ def _gripper(m: UrdfModel, s: str) -> None:
             ],
             0.17126 + 0.04419,
             source="mass 0.17126 + 0.04419 kg = finger + fingertip links (gripper_v0/gripper.urdf.xacro); "
+            "COM and inertia from the shapes (the published ones are of the linkage's revolute links); "
             "pad centred on the tool frame, 35 x 22 mm face",
         )
 
@@ -290,7 +417,17 @@ def build() -> UrdfModel:
         "base_link",
         [Geom("box", (0.65, 0.65, 0.29), (0.0, 0.0, 0.105))],
         116.0,
-        source="mass 116 kg (base_v0/base.urdf.xacro); box 0.65 m square (0.668 m footprint), top 0.35 m above floor",
+        com=(-0.061, 0.0, 0.5 * 0.293),
+        inertia=(
+            5.652232699207,
+            -0.009719934438,
+            1.293988226423,
+            5.669473158652,
+            -0.007379583694,
+            3.683196351726,
+        ),
+        source="mass 116 kg, COM (base_cg_x/y/z) and inertia as published (base_v0/base.urdf.xacro); box 0.65 m "
+        "square (0.668 m footprint), top 0.35 m above floor",
     )
     m.joint(
         "torso_lift_joint",
@@ -299,18 +436,27 @@ def build() -> UrdfModel:
         "torso_lift_link",
         xyz=(-0.05, 0.0, 0.739675),
         axis=(0, 0, 1),
-        lower=0.0,
-        upper=0.33,
+        **_soft("torso_lift", 0.0, 0.33),
         effort=10000,
         velocity=0.013,
         damping=20000.0,
-        source="origin -0.05 0 0.739675, limits 0..0.33 m, effort 10000, velocity 0.013 (torso_v0/torso.urdf.xacro)",
+        source="origin -0.05 0 0.739675 (pr2_description/robots/pr2.urdf.xacro), limits 0..0.33 m, soft "
+        "0.0115..0.325 m, effort 10000, velocity 0.013 (torso_v0/torso.urdf.xacro)",
     )
     m.link(
         "torso_lift_link",
         [Geom("box", (0.20, 0.14, 0.80), (-0.075, 0.0, -0.25))],
         36.248046,
-        source="mass 36.248046 kg (torso_v0/torso.urdf.xacro); column box stands in for the torso mesh, "
+        com=(-0.1, 0.0, -0.0885),
+        inertia=(
+            2.771653750257,
+            0.004284522609,
+            -0.160418504506,
+            2.510019507959,
+            0.029664468704,
+            0.526432355569,
+        ),
+        source="mass, COM and inertia as published (torso_v0/torso.urdf.xacro); column box stands in for the torso mesh, "
         "its front face 0.025 m ahead of the shoulder pan axes and 0.14 m wide (the 0.376 m between the "
         "shoulder pan axes is shoulder, not column) so that the shoulders pan fully inwards without touching it",
     )
