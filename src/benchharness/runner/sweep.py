@@ -127,7 +127,8 @@ def prepare(spec: RunSpec) -> TaskPlan:
     for s in spec.sensors:
         lookup("sensor", s, spec.plugins)
     item = lookup("strategy", spec.strategy, spec.plugins)
-    check_strategy_robot(spec.strategy, spec.robot, spec.plugins)  # the Python API too, not only the CLI
+    # the Python API too, not only the CLI
+    check_strategy_robot(spec.strategy, spec.robot, spec.plugins)
     supported = item.meta.get("benchmarks") or getattr(item.factory, "benchmarks", None)
     if supported is not None and plan.benchmark not in tuple(supported):
         raise ValueError(
