@@ -34,9 +34,31 @@ def emit_json(data: Any) -> None:
     click.echo(json.dumps(data, indent=2, default=_default, allow_nan=True))
 
 
+def _json_requested() -> bool:
+    """Whether the running command was given ``--json`` (its parsed ``as_json``)."""
+    ctx = click.get_current_context(silent=True)
+    while ctx is not None:
+        if ctx.params.get("as_json"):
+            return True
+        ctx = ctx.parent
+    return False
+
+
+def error_line(message: str, code: int, as_json: bool) -> str:
+    """One line: ``error: ...`` as text, or one JSON object under ``--json``."""
+    if as_json:
+        return json.dumps({"error": message, "exit_code": code})
+    return f"error: {message}"
+
+
 def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
-    """Print an error to stderr and exit (2 = bad input by default)."""
-    click.echo(f"error: {message}", err=True)
+    """Print an error to stderr as one line and exit (2 = bad input by default).
+
+    Under ``--json`` the line is one JSON object, ``{"error": message,
+    "exit_code": code}``, still on stderr (stdout carries results only) and
+    with the same exit code.
+    """
+    click.echo(error_line(" ".join(message.split()), code, _json_requested()), err=True)
     sys.exit(code)
 
 

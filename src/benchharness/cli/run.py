@@ -170,11 +170,13 @@ def _spec(
     from ..runner.plugins import lookup
     from ..runner.spec import RunSpec, parse_physics
     from ..runner.tasks import plan_task
+    from .validate import check_seed
 
     try:
+        check_seed(seed)
         physics = parse_physics(list(physics_kv))
     except ValueError as exc:
-        fail(f"--physics: {exc}")
+        fail(str(exc) if str(exc).startswith("--") else f"--physics: {exc}")
     if repeats < 1:
         fail("--repeats must be at least 1")
     for name, value in (("--sim-budget", sim_budget), ("--wall-budget", wall_budget)):
@@ -443,7 +445,10 @@ def run(
                 f"--video needs a backend that can render images; backend {backend!r} has no camera "
                 f"(capabilities.camera is false). Use --backend pybullet."
             )
+        from .validate import check_video_trial
+
         try:
+            check_video_trial(video_trial, trial_sel)
             video = VideoSpec(video_path, video_trial, video_fps)
         except ValueError as exc:
             fail(str(exc))
@@ -752,10 +757,12 @@ def compare(
       benchharness compare --backends pybullet,sapien --task Rubiks-1-5 --robot pr2 --strategy sensor-aided
     """
     from ..runner.reports import compare_backends
+    from .validate import check_backends
 
-    names = _names(backends)
-    if len(names) < 2:
-        fail("--backends: name at least two backends, comma-separated")
+    try:
+        names = check_backends(_names(backends))
+    except ValueError as exc:
+        fail(str(exc))
     runs = []
     with _open_store(store_path) as store:
         benchmark = None
