@@ -25,6 +25,8 @@ def _fmt(x: float, digits: int = 3) -> str:
         return "-"
     if x == 0:
         return "0"
+    if abs(x) >= 1e9:  # a huge error is shown, not spelled out in 200 digits
+        return f"{x:.{digits}g}"
     if abs(x) >= 10**digits:
         return f"{x:.0f}"
     return f"{x:.{digits}g}"
@@ -164,6 +166,8 @@ def score_cmd(
 
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         fail(f"--plot: {plot_path} must end in .png or .svg")
+    if not (math.isfinite(contact_tol) and contact_tol >= 0):
+        fail(f"--contact-tol {contact_tol:g}: must be a non-negative distance in metres")
     try:
         results = read_results(results_file)
         scored = score_results(
@@ -174,6 +178,8 @@ def score_cmd(
         fail(str(e))
     except KeyError as e:
         fail(f"--by: {e.args[0]}")
+    except ValueError as e:  # the metrics' own checks (e.g. an error beyond the float range)
+        fail(f"{results_file}: {e}")
     metrics = metrics_present(summaries)
     discarded = _discarded_rows(scored)
     has_setup = bool(results.has_setup.any())
