@@ -319,3 +319,83 @@ def import_bih_cmd(source: Path | None, out: Path | None, as_json: bool) -> None
     for f in report.files:
         click.echo(f"  wrote {f}")
     click.echo("  " + ", ".join(f"{k}={v}" for k, v in report.counts.items()))
+
+
+@inhand.command("regions")
+@click.argument("store", metavar="STORE", type=click.Path(path_type=Path))
+@json_option
+def regions_cmd(store: Path, as_json: bool) -> None:
+    """Contact-region errors (G_euc, G_geo, G_min) of the DMG trials in a results store.
+
+    Reads STORE (the SQLite file ``benchharness run`` writes) without
+    modifying it: every stored trial of ``inhand-level3-dmg`` and
+    ``inhand-level2-dmg-regions``, and for successful trials with reached
+    contacts Algorithm 1 on our mesh in the task frame (docs/dmg.md).
+
+    \b
+    Example:
+      benchharness inhand regions benchharness-results.sqlite
+    """
+    from ..strategies.dmg.regions import score_store
+
+    if not store.is_file():
+        fail(f"{store}: no such results store")
+    try:
+        rows = score_store(store)
+    except (OSError, ValueError) as exc:
+        fail(str(exc))
+    if as_json:
+        emit_json({"store": str(store), "trials": rows})
+        return
+    from rich.table import Table
+
+    from .run import _console, _esc
+
+    t = Table(title=f"contact-region errors of the DMG trials in {_esc(store)} (cm)")
+    for c in ("task", "backend", "trial", "task id", "status"):
+        t.add_column(c, overflow="fold", justify="right" if c == "trial" else "left")
+    for c in ("G_euc", "G_geo", "G_min"):
+        t.add_column(c, justify="right")
+    for r in rows:
+        g = [f"{r[k] * 100:.3f}" if k in r else "—" for k in ("g_euc", "g_geo", "g_min")]
+        t.add_row(
+            _esc(r["task"]),
+            _esc(r["backend"]),
+            str(r["trial"]),
+            _esc(r["task_id"]),
+            _esc(r["status"]),
+            *g,
+        )
+    _console().print(t)
+    if not rows:
+        click.echo("No DMG trials in this store (benchharness run --task inhand-level3-dmg ...).")
+
+
+@inhand.command("region-tasks")
+@click.option(
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Where to write the Level II task CSV (the tracked one is tasks/inhand/level2_dmg_regions.csv).",
+)
+@json_option
+def region_tasks_cmd(out: Path, as_json: bool) -> None:
+    """Derive the Level II contact-region task file from the published DMG tasks and write it to --out.
+
+    Deterministic: writing it over tasks/inhand/level2_dmg_regions.csv
+    reproduces the committed file (docs/dmg.md says how it is derived).
+
+    \b
+    Example:
+      benchharness inhand region-tasks --out /tmp/level2_dmg_regions.csv
+    """
+    from ..strategies.dmg.regions import write_region_tasks
+
+    if not out.parent.is_dir():
+        fail(f"--out {out}: folder {out.parent} does not exist")
+    path = write_region_tasks(out)
+    if as_json:
+        emit_json({"written": str(path)})
+    else:
+        click.echo(f"wrote {path}")
