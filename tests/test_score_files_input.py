@@ -99,3 +99,17 @@ def test_non_unit_quaternion_is_refused_with_its_row(tmp_path):
 def test_negative_contact_tol_is_refused():
     _one_error_line(_invoke("inhand", "score", DMG, "--contact-tol", "-1"), "--contact-tol -1")
     _one_error_line(_invoke("inhand", "score", DMG, "--contact-tol", "nan"), "--contact-tol nan")
+
+
+def test_errors_under_json_are_one_json_object_on_stderr(tmp_path):
+    # a command's own check and click's usage errors alike, exit code unchanged
+    for args, needle in (
+        (("inhand", "score", tmp_path / "missing.csv", "--json"), "missing.csv"),
+        (("rubiks", "sequence", "--tier", "Rubiks-5-5", "--seed", "-1", "--json"), "--seed"),
+        (("rubiks", "sequence", "--tier", "Nope", "--json"), "Nope"),
+    ):
+        r = _invoke(*args)
+        assert r.exit_code == 2 and r.stdout == ""
+        (line,) = [ln for ln in r.stderr.splitlines() if ln.strip()]
+        data = json.loads(line)
+        assert data["exit_code"] == 2 and needle in data["error"]

@@ -65,3 +65,41 @@ def fail(message: str, code: int = EXIT_BAD_INPUT) -> NoReturn:
 json_option = click.option(
     "--json", "as_json", is_flag=True, help="Print machine-readable JSON instead of text."
 )
+
+
+#: Width of plain text lines when output is not a terminal: lines are not
+#: re-wrapped for a pipe (tables get their own natural width, below).
+PIPE_WIDTH = 220
+
+
+def console(stderr: bool = False) -> Any:
+    """A rich console: the terminal's width in a terminal, :data:`PIPE_WIDTH` in a pipe."""
+    from rich.console import Console
+
+    con = Console(stderr=stderr)
+    if not con.is_terminal:  # piped or captured: do not wrap at 80 columns
+        con = Console(width=PIPE_WIDTH, stderr=stderr)
+    return con
+
+
+def print_table(table: Any, con: Any = None, stderr: bool = False) -> None:
+    """Print a rich table without ever truncating a cell.
+
+    Names one must type (plugins, joints, tasks) and failure messages are
+    never cut: every column folds (``overflow="fold"``, wrapping allowed)
+    instead of ending in an ellipsis, so in a narrow terminal a long cell
+    continues on the next line. In a pipe (not a terminal) the table is
+    printed at its natural width, whatever ``COLUMNS`` says, so each row
+    stays one greppable line.
+    """
+    from rich.console import Console
+
+    for col in table.columns:
+        col.overflow = "fold"
+        col.no_wrap = False
+    con = con if con is not None else console(stderr)
+    if not con.is_terminal:
+        natural = Console(width=100_000).measure(table).maximum
+        if natural > con.width:
+            con = Console(width=natural, stderr=stderr, file=con.file)
+    con.print(table)

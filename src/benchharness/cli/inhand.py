@@ -221,12 +221,12 @@ def score_cmd(
         emit_json(out)
         return
 
-    from rich.console import Console
     from rich.table import Table
 
-    console = Console()
-    if not console.is_terminal:  # piped or captured: do not wrap at 80 columns
-        console = Console(width=260)
+    from .common import console as rich_console
+    from .common import print_table
+
+    console = rich_console()
     table = Table(title=f"{results_file.name}: median [Q1, Q3] per {', '.join(summaries[0].by)}")
     for b in summaries[0].by:
         table.add_column(b, no_wrap=True)
@@ -241,7 +241,7 @@ def score_cmd(
             _fmt(s.drops_percent),
             *[_cell(s.stats[m], METRICS[m].scale) for m in metrics],
         )
-    console.print(table)
+    print_table(table, console)
     n_disc = len(discarded)
     if has_setup:
         console.print(f"{n_disc} of {len(results)} trials discarded by the 10 % set-up rule.")
@@ -269,7 +269,7 @@ def score_cmd(
                 _fmt(d["setup_err_pos_percent"]),
                 _fmt(d["setup_err_or_percent"]),
             )
-        console.print(t)
+        print_table(t, console)
     if plot_path is not None:
         console.print(f"Box plot written to {plot_path}")
 
@@ -349,7 +349,8 @@ def regions_cmd(store: Path, as_json: bool) -> None:
         return
     from rich.table import Table
 
-    from .run import _console, _esc
+    from .common import print_table
+    from .run import _esc
 
     t = Table(title=f"contact-region errors of the DMG trials in {_esc(store)} (cm)")
     for c in ("task", "backend", "trial", "task id", "status"):
@@ -366,7 +367,7 @@ def regions_cmd(store: Path, as_json: bool) -> None:
             _esc(r["status"]),
             *g,
         )
-    _console().print(t)
+    print_table(t)
     if not rows:
         click.echo("No DMG trials in this store (benchharness run --task inhand-level3-dmg ...).")
 

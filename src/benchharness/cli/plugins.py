@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import click
-from rich.console import Console
 from rich.table import Table
 
 from ..plugin import KIND_HOOKS, get_manager
-from .common import emit_json, json_option
+from .common import console as rich_console
+from .common import emit_json, json_option, print_table
 
 
 @click.command("plugins")
@@ -42,13 +42,13 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
             }
         )
         return
-    console = Console()
+    console = rich_console()
     table = Table(title="benchharness plugins")
     for col in ("kind", "name", "distribution", "summary"):
         table.add_column(col)
     # stable sort: by kind, then in registration order (tiers stay 1-5, 1-10, ...)
     for it in sorted(items, key=lambda i: list(KIND_HOOKS).index(i.kind)):
         table.add_row(it.kind, it.name, it.distribution, it.summary)
-    console.print(table)
+    print_table(table, console)
     for e in manager.errors:
         console.print(f"[red]failed:[/red] {e}")

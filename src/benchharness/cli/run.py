@@ -16,18 +16,14 @@ from typing import Any
 import click
 import numpy as np
 
-from .common import EXIT_NEGATIVE, emit_json, fail, json_option
+from .common import EXIT_NEGATIVE, emit_json, fail, json_option, print_table
+from .common import console as _rich_console
 
 _CTX = {"help_option_names": ["-h", "--help"], "max_content_width": 110}
 
 
 def _console(stderr: bool = False):
-    from rich.console import Console
-
-    console = Console(stderr=stderr)
-    if not console.is_terminal:  # piped or captured: do not wrap at 80 columns
-        console = Console(width=220, stderr=stderr)
-    return console
+    return _rich_console(stderr)
 
 
 def _fmt(x: float | None, digits: int = 2) -> str:
@@ -339,7 +335,7 @@ def _trials_table(rows, title: str, show_run: bool = False):
             t.failure_cause.value if t.failure_cause else "",
             _fmt(t.sim_s, 2),
             _fmt(t.wall_s, 2),
-            _esc((t.message or "")[:90]),
+            _esc(t.message or ""),
         )
     return table
 
@@ -483,13 +479,14 @@ def run(
             )
         else:
             console = _console()
-            console.print(
+            print_table(
                 _trials_table(
                     rows,
                     _esc(
                         f"{spec.task}: {spec.strategy} on {spec.robot}, {spec.backend}, seed {spec.seed}"
                     ),
-                )
+                ),
+                console,
             )
             console.print(
                 f"run {spec.run_key} in {store.path}: ran {report.ran}, skipped {len(report.skipped)} "
@@ -606,7 +603,7 @@ def table(
                     *[tab.published_cell(tier, k) for k, _ in tab.published],
                     *[format_cell(tab.cells.get((tier, c.label))) for c in tab.columns],
                 )
-            console.print(t)
+            print_table(t, console)
             if not tab.columns:
                 console.print(
                     "No Rubik's results in the store yet (benchharness run --task Rubiks-...)."
@@ -646,7 +643,7 @@ def table(
                     _fmt(r.get("err_or_percent")),
                     str(r.get("failed_other", "")),
                 )
-            console.print(t)
+            print_table(t, console)
             methods: dict[str, list] = {}
             for r in t3:
                 methods.setdefault(r["method"], []).append(r)
@@ -665,7 +662,7 @@ def table(
                         )
                     t.add_row(label, *cells)
                 t.add_row("drops %", *[_fmt(r["drops_percent"], 1) for r in rows])
-                console.print(t)
+                print_table(t, console)
     if plot_path is not None:
         try:
             inhand_box_plot(trials, plot_path)
@@ -810,7 +807,7 @@ def compare(
             else:
                 cells += [c["cause"] or c["status"], _fmt(c["score"], 3), _fmt(c["sim_s"], 2)]
         t.add_row(*cells)
-    console.print(t)
+    print_table(t, console)
     s = Table(title="summary")
     for c in (
         "backend",
@@ -835,7 +832,7 @@ def compare(
             causes,
             _fmt(v["real_time_factor"], 2),
         )
-    console.print(s)
+    print_table(s, console)
     if benchmark == "inhand":
         h = Table(title="in-hand, per backend (Table II layout): medians over scored trials")
         for c in ("backend", "n", "discarded", "drops %", "err_pos (cm)", "err_pos%", "err_or%"):
@@ -851,7 +848,7 @@ def compare(
                 _fmt(v.get("err_pos_percent")),
                 _fmt(v.get("err_or_percent")),
             )
-        console.print(h)
+        print_table(h, console)
 
 
 # -- results -----------------------------------------------------------------------------------
@@ -907,13 +904,15 @@ def results(
     if run_prefix:
         rows = [t for t in rows if t.run_key.startswith(run_prefix)]
     plotted = None
+    off_scale: list = []
     if plot_path is not None:
         from ..runner.plots import plot_pose_error
 
         try:
-            plotted = str(plot_pose_error(rows, plot_path))
+            drawn = plot_pose_error(rows, plot_path)
         except ValueError as exc:
             fail(str(exc), EXIT_NEGATIVE)
+        plotted, off_scale = str(drawn.path), list(drawn.outliers)
     if as_json:
         data = []
         for t in rows:
@@ -922,11 +921,14 @@ def results(
                 d["traceback"] = t.traceback
             d["diagnostics_counts"] = t.diagnostics.get("counts", {})
             data.append(d)
-        emit_json({"trials": data, "plot": plotted})
+        emit_json(
+            {"trials": data, "plot": plotted, "plot_off_scale": [o.to_dict() for o in off_scale]}
+        )
         return
     console = _console()
-    console.print(
-        _trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True)
+    print_table(
+        _trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True),
+        console,
     )
     if show_tb:
         for t in rows:
@@ -935,3 +937,5 @@ def results(
                 console.print(t.traceback, markup=False, highlight=False)
     if plotted:
         console.print(f"pose-error plot written to {plotted}")
+        for o in off_scale:
+            console.print(f"  off-scale (drawn on the top edge): {_esc(o.describe())}")
