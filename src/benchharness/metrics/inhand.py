@@ -170,7 +170,7 @@ def score_trials(
 
 def summarize_scores(
     scores: TrialScores,
-    columns: Mapping[str, Sequence],
+    columns: Mapping[str, Sequence | np.ndarray],
     by: Sequence[str],
     dropped: np.ndarray,
 ) -> list[GroupStats]:

@@ -97,7 +97,7 @@ def box_stats(values: Iterable[float], whis: float = 1.5) -> BoxStats:
 
 
 def group_indices(
-    columns: Mapping[str, Sequence], by: Sequence[str]
+    columns: Mapping[str, Sequence | np.ndarray], by: Sequence[str]
 ) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """Row indices per distinct key of the ``by`` columns, in order of first appearance.
 
@@ -136,7 +136,7 @@ class GroupStats:
 
 
 def summarize_groups(
-    columns: Mapping[str, Sequence],
+    columns: Mapping[str, Sequence | np.ndarray],
     by: Sequence[str],
     values: Mapping[str, np.ndarray],
     *,

@@ -122,7 +122,10 @@ def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Col
                     f"seed {t.seed}" if f == "seed" else f"{f.split('_')[0]} {getattr(t, f)}"
                 )
         labels[k] = base[k] + (" " + ", ".join(extra) if extra else "")
-    cols = {k: Column(labels[k], *k[:7], ", ".join(codes[k])) for k in raw}
+    cols = {
+        k: Column(labels[k], k[0], k[1], k[2], k[3], k[4], k[5], k[6], ", ".join(codes[k]))
+        for k in raw
+    }
     return list(cols.values()), {run: cols[k] for run, k in by_run.items()}
 
 
@@ -146,7 +149,7 @@ def rubiks_cell(trials: Sequence[StoredTrial], required: int) -> RubiksCell:
     indices = {t.trial_index for t in trials}
     ok = [t for t in trials if t.status is TrialStatus.SUCCESS and t.score is not None]
     completed = indices == set(range(1, required + 1)) and len(ok) == required
-    mean, std = mean_and_std([t.score for t in ok])
+    mean, std = mean_and_std([float(t.score) for t in ok if t.score is not None])
     causes = Counter(t.failure_cause.value for t in trials if t.failure_cause is not None)
     sims = [t.sim_s for t in trials if t.sim_s is not None]
     walls = [t.wall_s for t in trials if t.wall_s is not None]
