@@ -117,3 +117,13 @@ def test_errors_under_json_are_one_json_object_on_stderr(store_path):
     line = _refused(run, [*RUN, "--physics", "timestep=0", "--json"], store_path)
     data = json.loads(line)
     assert data["exit_code"] == 2 and "timestep=0" in data["error"]
+
+
+@pytest.mark.parametrize("command", ["table", "results"])
+def test_seed_filter_beyond_the_store_is_one_line_not_an_overflow(store_path, command):
+    from benchharness.cli.main import cli
+
+    r = CliRunner().invoke(cli, [command, "--seed", str(2**64), "--store", str(store_path)])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    (line,) = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert "--seed" in line and str(2**64) in line

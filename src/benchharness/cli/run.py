@@ -18,8 +18,12 @@ import numpy as np
 
 from .common import EXIT_NEGATIVE, emit_json, fail, json_option, print_table
 from .common import console as _rich_console
+from .validate import SEED_MAX
 
 _CTX = {"help_option_names": ["-h", "--help"], "max_content_width": 110}
+
+#: A seed filter the store can hold (a larger one would be an SQLite OverflowError).
+_SEED = click.IntRange(0, SEED_MAX)
 
 
 def _console(stderr: bool = False):
@@ -523,7 +527,7 @@ def run(
 @click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
 @click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
 @click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
-@click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
+@click.option("--seed", "seeds", multiple=True, type=_SEED, help="Only these seeds (repeatable).")
 @click.option(
     "--run-tiers",
     is_flag=True,
@@ -861,7 +865,7 @@ def compare(
 @click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
 @click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
 @click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
-@click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
+@click.option("--seed", "seeds", multiple=True, type=_SEED, help="Only these seeds (repeatable).")
 @click.option("--run", "run_prefix", default=None, help="Only the run whose key starts with this.")
 @click.option("--traceback", "show_tb", is_flag=True, help="Print each failed trial's traceback.")
 @click.option(
