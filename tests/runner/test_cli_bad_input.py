@@ -127,3 +127,18 @@ def test_seed_filter_beyond_the_store_is_one_line_not_an_overflow(store_path, co
     assert r.exit_code == 2 and "Traceback" not in r.output
     (line,) = [ln for ln in r.stderr.splitlines() if ln.strip()]
     assert "--seed" in line and str(2**64) in line
+
+
+@pytest.mark.parametrize("opt", ["--sim-budget", "--wall-budget"])
+@pytest.mark.parametrize("value", ["nan", "inf", "-1"])
+def test_non_finite_or_negative_budgets_are_refused(store_path, opt, value):
+    _refused(run, [*RUN, opt, value], store_path, f"{opt} {float(value)}")
+
+
+def test_nan_video_fps_is_refused(store_path, tmp_path):
+    _refused(
+        run,
+        [*RUN, "--video", str(tmp_path / "v.gif"), "--video-fps", "nan"],
+        store_path,
+        "--video-fps nan",
+    )

@@ -180,8 +180,8 @@ def _spec(
     if repeats < 1:
         fail("--repeats must be at least 1")
     for name, value in (("--sim-budget", sim_budget), ("--wall-budget", wall_budget)):
-        if value is not None and value <= 0:
-            fail(f"{name} must be positive")
+        if value is not None and not (value > 0 and value != float("inf")):  # NaN fails too
+            fail(f"{name} {value}: must be a positive finite number of seconds")
     try:
         item = lookup("task", task, tuple(plugins))
         plan = plan_task(item.name, item.create(), seed, repeats)
@@ -449,6 +449,8 @@ def run(
 
         try:
             check_video_trial(video_trial, trial_sel)
+            if not (video_fps > 0 and video_fps != float("inf")):
+                raise ValueError(f"--video-fps {video_fps}: must be a positive finite number")
             video = VideoSpec(video_path, video_trial, video_fps)
         except ValueError as exc:
             fail(str(exc))
