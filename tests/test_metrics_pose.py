@@ -50,11 +50,16 @@ def test_err_or_percent_vectorised_and_half_turn_is_100():
     )
 
 
-def test_normalisation_is_a_choice():
+def test_normalisation_is_a_choice_within_the_tolerance():
+    # inside QUAT_NORM_TOL (rounded data) the raw value is eq. 3 on the numbers given
     q = np.array([0.0, 0.0, 0.0, 1.0])
-    q_scaled = 1.01 * q
-    assert err_or_percent(q, q_scaled) == pytest.approx(100 * 0.01 / np.sqrt(2))
+    q_scaled = 1.001 * q
+    assert err_or_percent(q, q_scaled) == pytest.approx(100 * 0.001 / np.sqrt(2))
     assert err_or_percent(q, q_scaled, normalize=True) == pytest.approx(0.0)
+    # beyond it, only an explicit normalize=True scores it
+    with pytest.raises(ValueError, match="q_r: row 0 is not a unit quaternion"):
+        err_or_percent(q, 1.01 * q)
+    assert err_or_percent(q, 1.01 * q, normalize=True) == pytest.approx(0.0)
 
 
 def _setup_case(setup_offset, setup_angle):

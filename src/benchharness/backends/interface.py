@@ -109,6 +109,44 @@ class PhysicsConfig:
     torsional_friction: float = 0.01
     seed: int = 0  #: seeds any randomness a backend itself uses
 
+    def __post_init__(self) -> None:
+        """Refuse settings no engine can simulate, here so the Python API is guarded too.
+
+        A zero timestep divides by zero in the stepping loop, a negative one
+        runs simulated time backwards, NaN poisons every pose, and zero solver
+        iterations or negative friction are not physics. ``ValueError`` names
+        the field and the value (``--physics`` prints it as is).
+        """
+        import math
+        from numbers import Integral, Real
+
+        def real(name: str, value: object, *, positive: bool) -> None:
+            ok = isinstance(value, Real) and not isinstance(value, bool)
+            if ok:
+                x = float(value)  # type: ignore[arg-type]
+                ok = math.isfinite(x) and (x > 0 if positive else x >= 0)
+            if not ok:
+                kind = "a positive" if positive else "a non-negative"
+                raise ValueError(f"{name}={value!r}: must be {kind} finite number")
+
+        real("timestep", self.timestep, positive=True)
+        real("contact_offset", self.contact_offset, positive=True)
+        real("default_friction", self.default_friction, positive=False)
+        real("torsional_friction", self.torsional_friction, positive=False)
+        g = tuple(self.gravity)
+        if len(g) != 3 or not all(
+            isinstance(v, Real) and not isinstance(v, bool) and math.isfinite(v) for v in g
+        ):
+            raise ValueError(f"gravity={self.gravity!r}: must be three finite numbers")
+        it = self.solver_iterations
+        if it is not None and (isinstance(it, bool) or not isinstance(it, Integral) or it < 1):
+            raise ValueError(f"solver_iterations={it!r}: must be an integer >= 1 (or None)")
+        vit = self.solver_velocity_iterations
+        if isinstance(vit, bool) or not isinstance(vit, Integral) or vit < 0:
+            raise ValueError(f"solver_velocity_iterations={vit!r}: must be an integer >= 0")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, Integral) or self.seed < 0:
+            raise ValueError(f"seed={self.seed!r}: must be an integer >= 0")
+
 
 @dataclass(frozen=True)
 class Box:

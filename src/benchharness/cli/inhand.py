@@ -25,6 +25,8 @@ def _fmt(x: float, digits: int = 3) -> str:
         return "-"
     if x == 0:
         return "0"
+    if abs(x) >= 1e9:  # a huge error is shown, not spelled out in 200 digits
+        return f"{x:.{digits}g}"
     if abs(x) >= 10**digits:
         return f"{x:.0f}"
     return f"{x:.{digits}g}"
@@ -164,6 +166,8 @@ def score_cmd(
 
     if plot_path is not None and plot_path.suffix.lower() not in (".png", ".svg"):
         fail(f"--plot: {plot_path} must end in .png or .svg")
+    if not (math.isfinite(contact_tol) and contact_tol >= 0):
+        fail(f"--contact-tol {contact_tol:g}: must be a non-negative distance in metres")
     try:
         results = read_results(results_file)
         scored = score_results(
@@ -174,6 +178,8 @@ def score_cmd(
         fail(str(e))
     except KeyError as e:
         fail(f"--by: {e.args[0]}")
+    except ValueError as e:  # the metrics' own checks (e.g. an error beyond the float range)
+        fail(f"{results_file}: {e}")
     metrics = metrics_present(summaries)
     discarded = _discarded_rows(scored)
     has_setup = bool(results.has_setup.any())
@@ -215,12 +221,12 @@ def score_cmd(
         emit_json(out)
         return
 
-    from rich.console import Console
     from rich.table import Table
 
-    console = Console()
-    if not console.is_terminal:  # piped or captured: do not wrap at 80 columns
-        console = Console(width=260)
+    from .common import console as rich_console
+    from .common import print_table
+
+    console = rich_console()
     table = Table(title=f"{results_file.name}: median [Q1, Q3] per {', '.join(summaries[0].by)}")
     for b in summaries[0].by:
         table.add_column(b, no_wrap=True)
@@ -235,7 +241,7 @@ def score_cmd(
             _fmt(s.drops_percent),
             *[_cell(s.stats[m], METRICS[m].scale) for m in metrics],
         )
-    console.print(table)
+    print_table(table, console)
     n_disc = len(discarded)
     if has_setup:
         console.print(f"{n_disc} of {len(results)} trials discarded by the 10 % set-up rule.")
@@ -263,7 +269,7 @@ def score_cmd(
                 _fmt(d["setup_err_pos_percent"]),
                 _fmt(d["setup_err_or_percent"]),
             )
-        console.print(t)
+        print_table(t, console)
     if plot_path is not None:
         console.print(f"Box plot written to {plot_path}")
 
@@ -313,3 +319,84 @@ def import_bih_cmd(source: Path | None, out: Path | None, as_json: bool) -> None
     for f in report.files:
         click.echo(f"  wrote {f}")
     click.echo("  " + ", ".join(f"{k}={v}" for k, v in report.counts.items()))
+
+
+@inhand.command("regions")
+@click.argument("store", metavar="STORE", type=click.Path(path_type=Path))
+@json_option
+def regions_cmd(store: Path, as_json: bool) -> None:
+    """Contact-region errors (G_euc, G_geo, G_min) of the DMG trials in a results store.
+
+    Reads STORE (the SQLite file ``benchharness run`` writes) without
+    modifying it: every stored trial of ``inhand-level3-dmg`` and
+    ``inhand-level2-dmg-regions``, and for successful trials with reached
+    contacts Algorithm 1 on our mesh in the task frame (docs/dmg.md).
+
+    \b
+    Example:
+      benchharness inhand regions benchharness-results.sqlite
+    """
+    from ..strategies.dmg.regions import score_store
+
+    if not store.is_file():
+        fail(f"{store}: no such results store")
+    try:
+        rows = score_store(store)
+    except (OSError, ValueError) as exc:
+        fail(str(exc))
+    if as_json:
+        emit_json({"store": str(store), "trials": rows})
+        return
+    from rich.table import Table
+
+    from .common import print_table
+    from .run import _esc
+
+    t = Table(title=f"contact-region errors of the DMG trials in {_esc(store)} (cm)")
+    for c in ("task", "backend", "trial", "task id", "status"):
+        t.add_column(c, overflow="fold", justify="right" if c == "trial" else "left")
+    for c in ("G_euc", "G_geo", "G_min"):
+        t.add_column(c, justify="right")
+    for r in rows:
+        g = [f"{r[k] * 100:.3f}" if k in r else "—" for k in ("g_euc", "g_geo", "g_min")]
+        t.add_row(
+            _esc(r["task"]),
+            _esc(r["backend"]),
+            str(r["trial"]),
+            _esc(r["task_id"]),
+            _esc(r["status"]),
+            *g,
+        )
+    print_table(t)
+    if not rows:
+        click.echo("No DMG trials in this store (benchharness run --task inhand-level3-dmg ...).")
+
+
+@inhand.command("region-tasks")
+@click.option(
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Where to write the Level II task CSV (the tracked one is tasks/inhand/level2_dmg_regions.csv).",
+)
+@json_option
+def region_tasks_cmd(out: Path, as_json: bool) -> None:
+    """Derive the Level II contact-region task file from the published DMG tasks and write it to --out.
+
+    Deterministic: writing it over tasks/inhand/level2_dmg_regions.csv
+    reproduces the committed file (docs/dmg.md says how it is derived).
+
+    \b
+    Example:
+      benchharness inhand region-tasks --out /tmp/level2_dmg_regions.csv
+    """
+    from ..strategies.dmg.regions import write_region_tasks
+
+    if not out.parent.is_dir():
+        fail(f"--out {out}: folder {out.parent} does not exist")
+    path = write_region_tasks(out)
+    if as_json:
+        emit_json({"written": str(path)})
+    else:
+        click.echo(f"wrote {path}")

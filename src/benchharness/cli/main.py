@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import importlib
+import sys
 
 import click
 
 from .. import __version__
+from .common import error_line
 
 #: Subcommand modules and the click object each exports. Each subcommand lives
 #: in its own module so that importing the CLI does not import simulators.
@@ -24,7 +26,32 @@ SUBCOMMANDS = {
 
 
 class LazyGroup(click.Group):
-    """Imports a subcommand's module only when that subcommand is used."""
+    """Imports a subcommand's module only when that subcommand is used.
+
+    Also prints click's own usage errors (an unknown option, a value out of
+    range) as the one line every other bad input gets, a JSON object under
+    ``--json``, exit 2 as before.
+    """
+
+    def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        argv = list(sys.argv[1:] if args is None else args)
+        try:
+            rv = super().main(argv, prog_name, complete_var, standalone_mode=False, **extra)
+        except click.exceptions.UsageError as exc:
+            message = exc.format_message()
+            if exc.ctx is not None and exc.ctx.command_path and "--json" not in argv:
+                message += f" (see {exc.ctx.command_path} --help)"
+            click.echo(error_line(message, exc.exit_code, "--json" in argv), err=True)
+            sys.exit(exc.exit_code)
+        except click.ClickException as exc:
+            click.echo(error_line(exc.format_message(), exc.exit_code, "--json" in argv), err=True)
+            sys.exit(exc.exit_code)
+        except click.exceptions.Abort:
+            click.echo("Aborted!", err=True)
+            sys.exit(1)
+        if not standalone_mode:
+            return rv
+        sys.exit(rv if isinstance(rv, int) else 0)
 
     def list_commands(self, ctx: click.Context) -> list[str]:
         return sorted(SUBCOMMANDS)

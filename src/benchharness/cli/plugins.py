@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import click
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
 from ..plugin import DISABLED_ENV, KIND_HOOKS, get_manager
-from .common import emit_json, json_option
+from .common import console as rich_console
+from .common import emit_json, json_option, print_table
 
 
 @click.command("plugins")
@@ -50,7 +50,7 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
             }
         )
         return
-    console = Console()
+    console = rich_console()
     table = Table(title="benchharness plugins")
     for col in ("kind", "name", "distribution", "entry point", "summary"):
         table.add_column(col)
@@ -60,7 +60,7 @@ def plugins_cmd(kind: str | None, as_json: bool) -> None:
         table.add_row(
             it.kind, it.name, it.distribution, escape(it.entry_point.split(" = ")[0]), it.summary
         )
-    console.print(table)
+    print_table(table, console)
     for e in manager.errors:
         console.print(f"[red]failed:[/red] {escape(str(e))}")
     for d in manager.disabled:

@@ -11,11 +11,11 @@ from pathlib import Path
 
 import click
 import numpy as np
-from rich.console import Console
 from rich.table import Table
 
 from ..plugin import get_manager
-from .common import EXIT_BAD_INPUT, emit_json, fail, json_option
+from .common import EXIT_BAD_INPUT, emit_json, fail, json_option, print_table
+from .common import console as rich_console
 
 #: The backend that renders snapshots when the chosen one cannot (PyBullet's TinyRenderer is headless).
 RENDER_FALLBACK = "pybullet"
@@ -50,7 +50,7 @@ def robots_cmd(as_json: bool) -> None:
             r["distribution"],
             r["summary"],
         )
-    Console().print(table)
+    print_table(table)
 
 
 @click.group()
@@ -169,7 +169,7 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
     if as_json:
         emit_json(data)
         return
-    con = Console()
+    con = rich_console()
     con.print(
         f"[bold]{rob.name}[/bold] on {backend_name}: {rob.dof} DOF, {mass:.2f} kg, {rob.urdf_path}"
     )
@@ -186,13 +186,13 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
             f"{j['max_effort']:.1f}",
             f"{j['home']:.3f}",
         )
-    con.print(t)
+    print_table(t, con)
     g = Table(title="groups")
     g.add_column("group")
     g.add_column("joints")
     for k, v in data["groups"].items():
         g.add_row(k, ", ".join(v))
-    con.print(g)
+    print_table(g, con)
     f = Table(title="tool frames in the home pose (world; quaternion x, y, z, w)")
     for col in ("group", "link", "position (m)", "quaternion"):
         f.add_column(col)
@@ -203,7 +203,7 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
             np.array2string(np.asarray(v["position"]), precision=4),
             np.array2string(np.asarray(v["quaternion_xyzw"]), precision=4),
         )
-    con.print(f)
+    print_table(f, con)
     if png is not None:
         note = (
             ""

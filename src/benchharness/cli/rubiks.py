@@ -27,6 +27,7 @@ from ..cube import (
     parse_sequence,
 )
 from .common import EXIT_NEGATIVE, emit_json, fail, json_option
+from .validate import SEED_MAX
 
 _CTX = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -101,10 +102,10 @@ def tiers_cmd(as_json: bool) -> None:
 )
 @click.option(
     "--seed",
-    type=click.IntRange(min=0),
+    type=click.IntRange(min=0, max=SEED_MAX),
     default=0,
     show_default=True,
-    help="Non-negative integer seed; report it with your score.",
+    help="Integer seed in 0..2**63-1 (what a run's store holds); report it with your score.",
 )
 @json_option
 def sequence_cmd(tier_name: str, seed: int, as_json: bool) -> None:
@@ -273,7 +274,7 @@ def check_cmd(facelets: str, as_json: bool) -> None:
 @click.argument("log", type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "--seed",
-    type=click.IntRange(min=0),
+    type=click.IntRange(min=0, max=SEED_MAX),
     default=None,
     help="Also require each sequence to be the generator's for this seed.",
 )

@@ -16,18 +16,18 @@ from typing import Any
 import click
 import numpy as np
 
-from .common import EXIT_NEGATIVE, emit_json, fail, json_option
+from .common import EXIT_NEGATIVE, emit_json, fail, json_option, print_table
+from .common import console as _rich_console
+from .validate import SEED_MAX
 
 _CTX = {"help_option_names": ["-h", "--help"], "max_content_width": 110}
 
+#: A seed filter the store can hold (a larger one would be an SQLite OverflowError).
+_SEED = click.IntRange(0, SEED_MAX)
+
 
 def _console(stderr: bool = False):
-    from rich.console import Console
-
-    console = Console(stderr=stderr)
-    if not console.is_terminal:  # piped or captured: do not wrap at 80 columns
-        console = Console(width=220, stderr=stderr)
-    return console
+    return _rich_console(stderr)
 
 
 def _fmt(x: float | None, digits: int = 2) -> str:
@@ -172,16 +172,18 @@ def _spec(
     from ..runner.plugins import check_strategy_robot, lookup
     from ..runner.spec import RunSpec, parse_physics
     from ..runner.tasks import plan_task
+    from .validate import check_seed
 
     try:
+        check_seed(seed)
         physics = parse_physics(list(physics_kv))
     except ValueError as exc:
-        fail(f"--physics: {exc}")
+        fail(str(exc) if str(exc).startswith("--") else f"--physics: {exc}")
     if repeats < 1:
         fail("--repeats must be at least 1")
     for name, value in (("--sim-budget", sim_budget), ("--wall-budget", wall_budget)):
-        if value is not None and value <= 0:
-            fail(f"{name} must be positive")
+        if value is not None and not (value > 0 and value != float("inf")):  # NaN fails too
+            fail(f"{name} {value}: must be a positive finite number of seconds")
     try:
         item = lookup("task", task, tuple(plugins))
         plan = plan_task(item.name, item.create(), seed, repeats)
@@ -354,7 +356,7 @@ def _trials_table(rows, title: str, show_run: bool = False):
             t.failure_cause.value if t.failure_cause else "",
             _fmt(t.sim_s, 2),
             _fmt(t.wall_s, 2),
-            _esc((t.message or "")[:90]),
+            _esc(t.message or ""),
         )
     return table
 
@@ -460,7 +462,12 @@ def run(
                 f"--video needs a backend that can render images; backend {backend!r} has no camera "
                 f"(capabilities.camera is false). Use --backend pybullet."
             )
+        from .validate import check_video_trial
+
         try:
+            check_video_trial(video_trial, trial_sel)
+            if not (video_fps > 0 and video_fps != float("inf")):
+                raise ValueError(f"--video-fps {video_fps}: must be a positive finite number")
             video = VideoSpec(video_path, video_trial, video_fps)
         except ValueError as exc:
             fail(str(exc))
@@ -496,13 +503,14 @@ def run(
             )
         else:
             console = _console()
-            console.print(
+            print_table(
                 _trials_table(
                     rows,
                     _esc(
                         f"{spec.task}: {spec.strategy} on {spec.robot}, {spec.backend}, seed {spec.seed}"
                     ),
-                )
+                ),
+                console,
             )
             console.print(
                 f"run {spec.run_key} in {store.path}: ran {report.ran}, skipped {len(report.skipped)} "
@@ -544,7 +552,7 @@ def run(
 @click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
 @click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
 @click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
-@click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
+@click.option("--seed", "seeds", multiple=True, type=_SEED, help="Only these seeds (repeatable).")
 @click.option(
     "--run-tiers",
     is_flag=True,
@@ -624,7 +632,7 @@ def table(
                     *[tab.published_cell(tier, k) for k, _ in tab.published],
                     *[format_cell(tab.cells.get((tier, c.label))) for c in tab.columns],
                 )
-            console.print(t)
+            print_table(t, console)
             if not tab.columns:
                 console.print(
                     "No Rubik's results in the store yet (benchharness run --task Rubiks-...)."
@@ -664,7 +672,7 @@ def table(
                     _fmt(r.get("err_or_percent")),
                     str(r.get("failed_other", "")),
                 )
-            console.print(t)
+            print_table(t, console)
             methods: dict[str, list] = {}
             for r in t3:
                 methods.setdefault(r["method"], []).append(r)
@@ -683,7 +691,7 @@ def table(
                         )
                     t.add_row(label, *cells)
                 t.add_row("drops %", *[_fmt(r["drops_percent"], 1) for r in rows])
-                console.print(t)
+                print_table(t, console)
     if plot_path is not None:
         try:
             inhand_box_plot(trials, plot_path)
@@ -775,10 +783,12 @@ def compare(
       benchharness compare --backends pybullet,sapien --task Rubiks-1-5 --robot pr2 --strategy sensor-aided
     """
     from ..runner.reports import compare_backends
+    from .validate import check_backends
 
-    names = _names(backends)
-    if len(names) < 2:
-        fail("--backends: name at least two backends, comma-separated")
+    try:
+        names = check_backends(_names(backends))
+    except ValueError as exc:
+        fail(str(exc))
     runs = []
     with _open_store(store_path) as store:
         benchmark = None
@@ -838,7 +848,7 @@ def compare(
             else:
                 cells += [c["cause"] or c["status"], _fmt(c["score"], 3), _fmt(c["sim_s"], 2)]
         t.add_row(*cells)
-    console.print(t)
+    print_table(t, console)
     s = Table(title="summary")
     for c in (
         "backend",
@@ -863,7 +873,7 @@ def compare(
             causes,
             _fmt(v["real_time_factor"], 2),
         )
-    console.print(s)
+    print_table(s, console)
     if benchmark == "inhand":
         h = Table(title="in-hand, per backend (Table II layout): medians over scored trials")
         for c in ("backend", "n", "discarded", "drops %", "err_pos (cm)", "err_pos%", "err_or%"):
@@ -879,7 +889,7 @@ def compare(
                 _fmt(v.get("err_pos_percent")),
                 _fmt(v.get("err_or_percent")),
             )
-        console.print(h)
+        print_table(h, console)
 
 
 # -- results -----------------------------------------------------------------------------------
@@ -892,7 +902,7 @@ def compare(
 @click.option("--strategy", "strategies", multiple=True, help="Only these strategies (repeatable).")
 @click.option("--backend", "backends", multiple=True, help="Only these backends (repeatable).")
 @click.option("--robot", "robots", multiple=True, help="Only these robots (repeatable).")
-@click.option("--seed", "seeds", multiple=True, type=int, help="Only these seeds (repeatable).")
+@click.option("--seed", "seeds", multiple=True, type=_SEED, help="Only these seeds (repeatable).")
 @click.option("--run", "run_prefix", default=None, help="Only the run whose key starts with this.")
 @click.option("--traceback", "show_tb", is_flag=True, help="Print each failed trial's traceback.")
 @click.option(
@@ -935,13 +945,15 @@ def results(
     if run_prefix:
         rows = [t for t in rows if t.run_key.startswith(run_prefix)]
     plotted = None
+    off_scale: list = []
     if plot_path is not None:
         from ..runner.plots import plot_pose_error
 
         try:
-            plotted = str(plot_pose_error(rows, plot_path))
+            drawn = plot_pose_error(rows, plot_path)
         except ValueError as exc:
             fail(str(exc), EXIT_NEGATIVE)
+        plotted, off_scale = str(drawn.path), list(drawn.outliers)
     if as_json:
         data = []
         for t in rows:
@@ -950,11 +962,14 @@ def results(
                 d["traceback"] = t.traceback
             d["diagnostics_counts"] = t.diagnostics.get("counts", {})
             data.append(d)
-        emit_json({"trials": data, "plot": plotted})
+        emit_json(
+            {"trials": data, "plot": plotted, "plot_off_scale": [o.to_dict() for o in off_scale]}
+        )
         return
     console = _console()
-    console.print(
-        _trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True)
+    print_table(
+        _trials_table(rows, f"{'failed ' if failures else ''}trials ({len(rows)})", show_run=True),
+        console,
     )
     if show_tb:
         for t in rows:
@@ -963,3 +978,5 @@ def results(
                 console.print(t.traceback, markup=False, highlight=False)
     if plotted:
         console.print(f"pose-error plot written to {plotted}")
+        for o in off_scale:
+            console.print(f"  off-scale (drawn on the top edge): {_esc(o.describe())}")

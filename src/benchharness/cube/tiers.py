@@ -7,11 +7,15 @@ install reads the same file (through :func:`benchharness.paths.tasks_dir`).
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-import tomllib
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # Python 3.10 (requires-python >= 3.10): the same parser, as the tomli package
+    import tomli as tomllib
 
 from ..paths import tasks_dir
 from .moves import Move

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import QUAT_NORM_TOL
 from .records import POSE_FIELDS, POSE_STAGES, ResultSet, TaskSet
 
 __all__ = [
@@ -160,8 +161,16 @@ class _RowParser:
             raise self.err(
                 missing[0], f"pose {stage!r} is incomplete (empty: {', '.join(missing)})"
             )
-        if present.all() and np.linalg.norm(vals[3:]) < 1e-9:
-            raise self.err(cols[3], f"pose {stage!r} has a zero quaternion")
+        if present.all():
+            norm = float(np.linalg.norm(vals[3:]))
+            if norm < 1e-9:
+                raise self.err(cols[3], f"pose {stage!r} has a zero quaternion")
+            if abs(norm - 1.0) > QUAT_NORM_TOL:
+                raise self.err(
+                    cols[3],
+                    f"pose {stage!r} has a quaternion of norm {norm:.6g}, not a unit one "
+                    f"(tolerance {QUAT_NORM_TOL:g})",
+                )
         return vals
 
 
@@ -292,8 +301,19 @@ def _parse(path: Path | None, columns: Sequence[str], rows: Sequence[Mapping[str
     )
 
 
+def _text(path: Path, encoding: str) -> str:
+    try:
+        return path.read_text(encoding=encoding)
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(
+            path, f"is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset {exc.start})"
+        ) from None
+    except OSError as exc:
+        raise FileFormatError(path, f"cannot be read ({exc.strerror or exc})") from None
+
+
 def _read_csv(path: Path) -> tuple[list[str], list[dict[str, str]]]:
-    text = path.read_text(encoding="utf-8-sig")
+    text = _text(path, "utf-8-sig")
     reader = csv.reader(io.StringIO(text))
     try:
         header = [h.strip() for h in next(reader)]
@@ -340,7 +360,7 @@ def _flatten_json_record(rec: Mapping[str, Any], path: Path, row: int) -> dict[s
 
 def _read_json(path: Path, key: str) -> tuple[list[str], list[dict[str, Any]]]:
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(_text(path, "utf-8"))
     except json.JSONDecodeError as e:
         raise FileFormatError(path, f"is not valid JSON ({e.msg} at line {e.lineno})") from None
     records = data.get(key) if isinstance(data, Mapping) else data

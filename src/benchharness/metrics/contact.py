@@ -235,7 +235,19 @@ class ObjectSurface:
             if len(arr) and (arr.min() < 0 or arr.max() >= len(self.vertices)):
                 raise ValueError(f"vertex index out of range 0..{len(self.vertices) - 1}")
             return np.unique(arr.astype(np.int64))
-        arr = arr.astype(float).reshape(-1, 3) if arr.size else np.zeros((0, 3))
+        if arr.size == 0:
+            return np.zeros(0, dtype=np.int64)
+        try:
+            arr = arr.astype(float)
+        except (TypeError, ValueError):
+            raise ValueError("contact points: not numbers") from None
+        if arr.ndim == 1 and arr.shape == (3,):
+            arr = arr[None]
+        if arr.ndim != 2 or arr.shape[1] != 3:
+            raise ValueError(f"contact points: expected shape (n, 3), got {arr.shape}")
+        if np.isinf(arr).any():
+            raise ValueError("contact points: an infinite coordinate")
+        # NaN rows are "no point" (fixed-width logs pad with them).
         arr = arr[np.all(np.isfinite(arr), axis=1)]
         return np.unique(self.min_vertex(arr))
 
@@ -296,11 +308,27 @@ def contact_region_error(
     points ``P_r``) are each a mesh, a list of meshes, an integer array of
     object vertex indices, or an ``(n, 3)`` array of points, all in the object
     frame. Raises ``ValueError`` if either side touches no vertex (nothing to
-    measure: e.g. a link farther than ``contact_tol`` from the object).
+    measure: e.g. a link farther than ``contact_tol`` from the object), and
+    ``ValueError`` naming the argument for a negative or non-finite
+    ``contact_tol``, an unknown ``method``, points not shaped ``(n, 3)``, an
+    infinite coordinate or a vertex index out of range. NaN point rows are
+    skipped (padding of fixed-width logs).
     """
+    if method not in ("heat", "exact"):
+        raise ValueError(f"method: unknown geodesic method {method!r} (heat or exact)")
+    if not (
+        isinstance(contact_tol, (int, float)) and np.isfinite(contact_tol) and contact_tol >= 0
+    ):
+        raise ValueError(f"contact_tol: {contact_tol!r} is not a non-negative distance")
     surf = object_surface(mesh)
-    v_c = surf.vertices_of(desired, contact_tol)
-    p_r = surf.vertices_of(reached, contact_tol)
+    try:
+        v_c = surf.vertices_of(desired, contact_tol)
+    except ValueError as exc:
+        raise ValueError(f"desired: {exc}") from None
+    try:
+        p_r = surf.vertices_of(reached, contact_tol)
+    except ValueError as exc:
+        raise ValueError(f"reached: {exc}") from None
     if len(v_c) == 0:
         raise ValueError(
             "the desired contact region maps to no object vertex (intersect() found nothing)"

@@ -85,6 +85,18 @@ class TrialScores:
         }
 
 
+def _per_trial(a, n: int, name: str, dtype: type, fill: object) -> np.ndarray:
+    """One value per trial (``fill`` when absent); a different length is an error, not a broadcast."""
+    if a is None:
+        return np.full(n, fill, dtype=dtype)
+    arr: np.ndarray = np.asarray(a, dtype=dtype)
+    if arr.shape != (n,):
+        raise ValueError(f"{name}: expected {n} values (one per trial), got shape {arr.shape}")
+    if dtype is float and np.isinf(arr).any():
+        raise ValueError(f"{name}: trial {int(np.argmax(np.isinf(arr)))} is infinite")
+    return arr
+
+
 def score_trials(
     initial: np.ndarray,
     desired: np.ndarray,
@@ -105,17 +117,25 @@ def score_trials(
     :func:`~benchharness.metrics.contact.contact_region_error` result (or
     None) when contact metrics apply (Levels II and III). Dropped trials get
     NaN pose errors whatever their reached pose says.
+
+    Every argument must have one row per trial (nothing is broadcast); poses
+    are checked as in :mod:`benchharness.metrics.pose` (``ValueError`` naming
+    the argument for an infinite value or a non-unit quaternion).
     """
     ini = np.atleast_2d(np.asarray(initial, float))
+    n = len(ini)
+    if ini.shape != (n, 7):
+        raise ValueError(f"initial: expected shape (n, 7), got {np.shape(initial)}")
     des = np.atleast_2d(np.asarray(desired, float))
     rea = np.atleast_2d(np.asarray(reached, float)).copy()
-    n = len(ini)
-    for name, a in (("desired", des), ("reached", rea)):
+    su = np.full((n, 7), np.nan) if setup is None else np.atleast_2d(np.asarray(setup, float))
+    for name, a in (("desired", des), ("reached", rea), ("setup", su)):
         if a.shape != (n, 7):
             raise ValueError(f"{name}: expected shape ({n}, 7), got {a.shape}")
-    drop = np.zeros(n, bool) if dropped is None else np.asarray(dropped, bool)
+    drop = _per_trial(dropped, n, "dropped", bool, False)
+    plan = _per_trial(plan_time_s, n, "plan_time_s", float, np.nan)
+    exe = _per_trial(exec_time_s, n, "exec_time_s", float, np.nan)
     rea[drop] = np.nan
-    su = np.full((n, 7), np.nan) if setup is None else np.atleast_2d(np.asarray(setup, float))
     check = setup_check(
         ini[:, :3],
         ini[:, 3:],
@@ -142,15 +162,15 @@ def score_trials(
         g_euc=g["euc"],
         g_geo=g["geo"],
         g_min=g["min"],
-        plan_time_s=nan.copy() if plan_time_s is None else np.asarray(plan_time_s, float),
-        exec_time_s=nan.copy() if exec_time_s is None else np.asarray(exec_time_s, float),
+        plan_time_s=plan,
+        exec_time_s=exe,
         contact=tuple(contact) if contact is not None else (),
     )
 
 
 def summarize_scores(
     scores: TrialScores,
-    columns: Mapping[str, Sequence],
+    columns: Mapping[str, Sequence | np.ndarray],
     by: Sequence[str],
     dropped: np.ndarray,
 ) -> list[GroupStats]:

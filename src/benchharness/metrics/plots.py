@@ -4,7 +4,8 @@ One panel per metric, stacked; along x one cluster per group (object), one
 coloured box per method inside it. Boxes are drawn with ``Axes.bxp`` from
 the statistics of :func:`benchharness.metrics.stats.box_stats`: median line,
 quartile box, whiskers at the extreme inliers within 1.5 IQR, outliers as
-points. Uses the object-oriented matplotlib API with the Agg canvas, never
+points; a group with one sample (a box of zero height) is drawn as a
+median line and a diamond in its method's colour. Uses the object-oriented matplotlib API with the Agg canvas, never
 ``pyplot``, so it has no global figure state and needs no display.
 """
 
@@ -95,15 +96,17 @@ def box_plot(
     artists: dict[str, dict] = {}
     for ax, metric in zip(axes, shown):
         scale = scales.get(metric, 1.0)
-        stats, positions, faces = [], [], []
+        stats, positions, faces, flat = [], [], [], []
         for g, group in enumerate(groups):
             for h, hue in enumerate(hues):
                 cell = cells.get((group, hue))
                 if cell is None or cell.stats[metric].n == 0:
                     continue
-                stats.append(_scaled(cell.stats[metric], scale).as_bxp(f"{group} / {hue}"))
+                b = _scaled(cell.stats[metric], scale)
+                stats.append(b.as_bxp(f"{group} / {hue}"))
                 positions.append(g + (h - (len(hues) - 1) / 2) * width)
                 faces.append(colours[h])
+                flat.append(b.q3 <= b.q1)  # one sample (or all equal): a box of zero height
         art = ax.bxp(
             stats,
             positions=positions,
@@ -116,6 +119,26 @@ def box_plot(
         for patch, colour in zip(art["boxes"], faces):
             patch.set_facecolor(colour)
             patch.set_alpha(0.75)
+        # A zero-height box shows no face: only its black median line would be
+        # seen, with no method colour. Draw its median in the method's colour
+        # with a marker, so a single sample still says which method it is.
+        singles = []
+        for k in (k for k, f in enumerate(flat) if f):
+            art["medians"][k].set_color(faces[k])
+            art["medians"][k].set_linewidth(2.5)
+            singles.append(
+                ax.scatter(
+                    [positions[k]],
+                    [stats[k]["med"]],
+                    marker="D",
+                    s=22,
+                    color=faces[k],
+                    edgecolors="black",
+                    linewidths=0.6,
+                    zorder=3,
+                )
+            )
+        art["singles"] = singles
         artists[metric] = art
         ax.set_ylabel(labels.get(metric, metric))
         ax.grid(axis="y", alpha=0.3)

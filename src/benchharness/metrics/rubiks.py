@@ -352,6 +352,10 @@ def read_log(path: str | Path) -> list[RubiksTrial]:
         text = path.read_text(encoding="utf-8-sig")
     except OSError as exc:
         raise TrialLogError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise TrialLogError(
+            f"{path} is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset {exc.start})"
+        ) from None
     suffix = path.suffix.lower()
     if suffix == ".json" or (suffix != ".csv" and text.lstrip()[:1] in "[{"):
         trials = parse_json_log(text)

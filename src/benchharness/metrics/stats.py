@@ -60,10 +60,16 @@ class BoxStats:
 
 
 def box_stats(values: Iterable[float], whis: float = 1.5) -> BoxStats:
-    """Box-plot statistics; an empty sample (or all-NaN) gives NaNs and ``n=0``."""
+    """Box-plot statistics; an empty sample (or all-NaN) gives NaNs and ``n=0``.
+
+    NaN means "not measured" and is left out; an infinite value is a
+    ``ValueError`` (``values``), never silently dropped from the median.
+    """
     x = np.asarray(
         list(values) if not isinstance(values, np.ndarray) else values, dtype=float
     ).ravel()
+    if np.isinf(x).any():
+        raise ValueError(f"values: entry {int(np.argmax(np.isinf(x)))} is infinite")
     x = x[np.isfinite(x)]
     if len(x) == 0:
         nan = float("nan")
@@ -91,7 +97,7 @@ def box_stats(values: Iterable[float], whis: float = 1.5) -> BoxStats:
 
 
 def group_indices(
-    columns: Mapping[str, Sequence], by: Sequence[str]
+    columns: Mapping[str, Sequence | np.ndarray], by: Sequence[str]
 ) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """Row indices per distinct key of the ``by`` columns, in order of first appearance.
 
@@ -130,7 +136,7 @@ class GroupStats:
 
 
 def summarize_groups(
-    columns: Mapping[str, Sequence],
+    columns: Mapping[str, Sequence | np.ndarray],
     by: Sequence[str],
     values: Mapping[str, np.ndarray],
     *,
@@ -149,6 +155,14 @@ def summarize_groups(
     n = len(dropped)
     dropped = np.asarray(dropped, dtype=bool)
     discarded = np.zeros(n, bool) if discarded is None else np.asarray(discarded, dtype=bool)
+    if discarded.shape != (n,):
+        raise ValueError(f"discarded: expected {n} values, got shape {discarded.shape}")
+    for name, col in columns.items():
+        if len(col) != n:
+            raise ValueError(f"columns[{name!r}]: {len(col)} values, dropped has {n}")
+    for name, v in values.items():
+        if np.shape(v) != (n,):
+            raise ValueError(f"values[{name!r}]: expected {n} values, got shape {np.shape(v)}")
     out = []
     for key, idx in group_indices(columns, by):
         keep = idx[~discarded[idx]]

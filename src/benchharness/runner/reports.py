@@ -149,7 +149,7 @@ def rubiks_cell(trials: Sequence[StoredTrial], required: int) -> RubiksCell:
     indices = {t.trial_index for t in trials}
     ok = [t for t in trials if t.status is TrialStatus.SUCCESS and t.score is not None]
     completed = indices == set(range(1, required + 1)) and len(ok) == required
-    mean, std = mean_and_std([t.score for t in ok if t.score is not None])
+    mean, std = mean_and_std([float(t.score) for t in ok if t.score is not None])
     causes = Counter(t.failure_cause.value for t in trials if t.failure_cause is not None)
     sims = [t.sim_s for t in trials if t.sim_s is not None]
     walls = [t.wall_s for t in trials if t.wall_s is not None]

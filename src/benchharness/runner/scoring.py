@@ -146,15 +146,24 @@ def score_inhand(item: InhandItem, outcome: TrialOutcome) -> Verdict:
             data,
         )
     nan = np.nan
-    s = score_trials(
-        item.initial[None],
-        item.desired[None],
-        reached[None],
-        setup=setup[None],
-        dropped=np.array([dropped]),
-        plan_time_s=np.array([nan if outcome.plan_time_s is None else outcome.plan_time_s], float),
-        exec_time_s=np.array([nan if outcome.exec_time_s is None else outcome.exec_time_s], float),
-    )
+    try:
+        s = score_trials(
+            item.initial[None],
+            item.desired[None],
+            reached[None],
+            setup=setup[None],
+            dropped=np.array([dropped]),
+            plan_time_s=np.array(
+                [nan if outcome.plan_time_s is None else outcome.plan_time_s], float
+            ),
+            exec_time_s=np.array(
+                [nan if outcome.exec_time_s is None else outcome.exec_time_s], float
+            ),
+        )
+    except ValueError as exc:  # e.g. a non-unit reached quaternion: the strategy's report is bad
+        return Verdict(
+            TrialStatus.FAILURE, None, FailureCause.STRATEGY_ERROR, f"scoring: {exc}", data
+        )
     data["metrics"] = {k: _f(v[0]) for k, v in s.values().items()}
     data["discarded"] = bool(s.discarded[0])
     if dropped:

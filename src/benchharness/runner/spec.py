@@ -84,8 +84,10 @@ def parse_physics(pairs: Mapping[str, str] | list[str]) -> PhysicsConfig:
                 values[key] = int(raw)
             else:
                 values[key] = float(raw)
-        except ValueError:
+        except (ValueError, ZeroDivisionError):
             raise ValueError(f"physics setting {key}: cannot read {raw!r}") from None
+    # PhysicsConfig refuses values no engine can simulate (zero or negative
+    # timestep, NaN, negative friction ...), naming the field.
     return replace(base, **values)
 
 

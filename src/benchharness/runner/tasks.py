@@ -22,7 +22,7 @@ from ..cube.sequences import generate_sequence
 from ..cube.tiers import RubiksTier
 from .contract import InhandItem, RubiksItem, TrialItem
 
-__all__ = ["TaskPlan", "plan_task", "parse_trial_selection", "trial_task"]
+__all__ = ["TaskPlan", "parse_trial_indices", "parse_trial_selection", "plan_task", "trial_task"]
 
 
 @dataclass(frozen=True)
@@ -97,10 +97,12 @@ def plan_task(name: str, task: object, seed: int, repeats: int = 1) -> TaskPlan:
     )
 
 
-def parse_trial_selection(text: str | None, available: list[int]) -> list[int]:
-    """``"1,3-5"`` → [1, 3, 4, 5]; ``None`` → all. Unknown indices are an error."""
-    if not text:
-        return list(available)
+def parse_trial_indices(text: str) -> list[int]:
+    """The indices ``"1,3-5"`` names, sorted, before any task is known.
+
+    A reversed range (``5-3``) or a selection naming nothing is an error, not
+    an empty run that exits 0.
+    """
     chosen: list[int] = []
     for part in text.split(","):
         part = part.strip()
@@ -109,11 +111,23 @@ def parse_trial_selection(text: str | None, available: list[int]) -> list[int]:
         try:
             if "-" in part:
                 a, b = (int(x) for x in part.split("-", 1))
-                chosen.extend(range(a, b + 1))
             else:
-                chosen.append(int(part))
+                a = b = int(part)
         except ValueError:
             raise ValueError(f"--trials: cannot read {part!r} (use e.g. 1,3-5)") from None
+        if a > b:
+            raise ValueError(f"--trials: {part!r} is a reversed range (write {b}-{a})")
+        chosen.extend(range(a, b + 1))
+    if not chosen:
+        raise ValueError(f"--trials: {text!r} names no trial (use e.g. 1,3-5)")
+    return sorted(set(chosen))
+
+
+def parse_trial_selection(text: str | None, available: list[int]) -> list[int]:
+    """``"1,3-5"`` → [1, 3, 4, 5]; ``None`` → all. Unknown indices are an error."""
+    if not text:
+        return list(available)
+    chosen = parse_trial_indices(text)
     bad = sorted(set(chosen) - set(available))
     if bad:
         raise ValueError(

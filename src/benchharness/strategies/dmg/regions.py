@@ -66,11 +66,11 @@ def derive_region_tasks(level3_path: str | Path | None = None):
     )
 
 
-def write_region_tasks(path: str | Path | None = None) -> Path:
+def write_region_tasks(path: str | Path) -> Path:
+    """Write the Level II task file to ``path`` (no default: the tracked file is rewritten only when named)."""
     from ...inhand.fileformat import write_tasks
-    from ...paths import tasks_dir
 
-    path = Path(path) if path else tasks_dir() / "inhand" / REGION_TASK_FILE
+    path = Path(path)
     write_tasks(derive_region_tasks(), path)
     return path
 
@@ -144,14 +144,24 @@ def score_store(
 
     from ...plugin import get_manager
 
+    path = Path(store)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such results store")
     tasks = {}
     out = []
-    con = sqlite3.connect(str(store))
+    # Read-only: scoring a store never creates or modifies it. A WAL store
+    # with no -wal file has nothing outside the main file, and opening it
+    # even read-only would create -wal/-shm: read it as immutable then.
+    wal = path.with_name(path.name + "-wal").exists()
+    mode = "mode=ro" if wal else "mode=ro&immutable=1"
+    con = sqlite3.connect(f"{path.resolve().as_uri()}?{mode}", uri=True)
     try:
         rows = con.execute(
             "select task, backend, strategy, trial_index, status, outcome_json from trials "
             "order by task, backend, trial_index"
         ).fetchall()
+    except sqlite3.DatabaseError as exc:
+        raise ValueError(f"{path}: not a benchharness results store ({exc})") from None
     finally:
         con.close()
     for task, backend, strategy, idx, status, oj in rows:
@@ -177,19 +187,10 @@ def score_store(
     return out
 
 
-if (
-    __name__ == "__main__"
-):  # python -m benchharness.strategies.dmg.regions [STORE]: write the task file, or score a store
+if __name__ == "__main__":  # pragma: no cover - the old entry point, kept as a pointer
     import sys
 
-    if len(sys.argv) > 1:
-        for r in score_store(sys.argv[1]):
-            g = {
-                k: (f"{r[k] * 100:.3f} cm" if k in r else "—") for k in ("g_euc", "g_geo", "g_min")
-            }
-            print(
-                f"{r['task']:28s} {r['backend']:9s} trial {r['trial']:2d} {r['task_id']:32s} {r['status']:9s} "
-                f"G_euc {g['g_euc']}  G_geo {g['g_geo']}  G_min {g['g_min']}"
-            )
-    else:
-        print(write_region_tasks())
+    sys.exit(
+        "error: this module is no longer a command; use `benchharness inhand regions STORE` "
+        "(contact-region errors) or `benchharness inhand region-tasks --out PATH` (the task file)"
+    )
