@@ -140,3 +140,24 @@ def test_with_default_errors_the_trial_is_run_and_scored(tmp_path, backend, stra
         assert cause in ("wrong_state", "dropped", "jammed", "unreachable", "timeout")
     d = json.loads(diag)
     assert d["pose_estimates"], "no true-vs-believed pose was recorded"
+
+
+def test_twisting_pose_keeps_every_planned_grip_and_turn_inside_the_soft_limits():
+    """The default twisting pose (and the pick below it) is reachable with margin inside the PR2's soft
+    limits for every grip family and both hand-over turns; the former (0.60, 0, 0.80) m had no smooth
+    turn about z inside them — the cause of the soft-limit Rubiks-5-10 failures (docs/strategies.md)."""
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+    from benchharness.strategies.pr2_rubiks.workspace import _left_arm, margins
+
+    cfg = PR2RubiksConfig()
+    b, arm = _left_arm()
+    try:
+        assert arm.robot.config.soft_limits
+        pick = (*cfg.cube_xy, cfg.table_height + 0.0285)
+        for centre in (cfg.twist_position, pick):
+            m = margins(arm, centre, cfg)
+            assert min(v for v, _ in m.values()) > 0.2, (centre, m)  # rad inside every soft limit
+        old = margins(arm, (0.60, 0.0, 0.80), cfg)
+        assert old["turn_z"][0] == float("-inf")
+    finally:
+        b.close()

@@ -19,16 +19,22 @@ __all__ = ["ErrorConfig", "PR2RubiksConfig"]
 class PR2RubiksConfig:
     """Scene, grasp geometry and motion settings of the PR2 baselines (metres, seconds)."""
 
-    #: height of the table top (m): below the PR2's home grippers (0.79 m) so that a side grasp
-    #: of the cube's middle (0.7285 m) is a short reach down.
-    table_height: float = 0.70
+    #: height of the table top (m): 7 cm below the twisting pose's cube bottom, so that the pick is
+    #: a straight lift (the cube centre on the table at 0.5285 m) and no finger reaches the table
+    #: at the twisting pose. Low because the twisting pose is (docs/strategies.md, "Twisting pose").
+    table_height: float = 0.50
     #: half extents (x, y) of the table top (m): narrow in y (a pedestal) so that a side grasp's
     #: wrist (18 cm behind the tool frame, 3.5 cm radius) passes beside it, not through it.
     table_half_size: tuple[float, float] = (0.10, 0.06)
-    #: cube centre on the table in the robot base frame (x forward, y left): the workspace centre.
+    #: cube centre on the table in the robot base frame (x forward, y left): below the twisting pose
+    #: (at x = 0.65 m the pick's stand-off is out of reach inside the soft limits).
     cube_xy: tuple[float, float] = (0.60, 0.0)
-    #: where the cube is held for twisting (cube centre, robot base frame).
-    twist_position: tuple[float, float, float] = (0.60, 0.0, 0.80)
+    #: where the cube is held for twisting (cube centre, robot base frame), from an IK scan
+    #: (:mod:`.workspace`): every grip the planner uses, its stand-off and both hand-over turns
+    #: (with the giver's retreat) stay >= 0.26 rad inside the PR2's soft limits here, and the pick
+    #: directly below it >= 0.42 rad; at the former (0.60, 0, 0.80) the turn about z had no smooth
+    #: solution inside them (docs/strategies.md, "Twisting pose").
+    twist_position: tuple[float, float, float] = (0.60, 0.0, 0.60)
     #: distance from the cube centre to the tool frame along the work axis for a grip
     #: `depth` slabs deep. The 35 mm pad is centred on the tool frame, so its inner end sits
     #: `offset - 17.5 mm` from the centre. Holder 17.5 mm -> inner end at 0: on the middle slab

@@ -675,7 +675,9 @@ class DeadReckoningStrategy:
             raise StrategyFailure("jammed", f"twist {k + 1} ({move}): {reason}")
         cube.begin_twist(body_axis, intended=intended)
         delta = self._roll_delta(t)
-        q = rot.arm.positions().copy()
+        # from the measured joints, which track a goal on a soft limit to within ~1e-4 rad of either
+        # side: the goal is kept on the limit (measured: one goal 1e-4 rad past the upper-arm roll's)
+        q = np.clip(rot.arm.positions(), rot.arm.lower, rot.arm.upper)
         q[-1] += delta  # the wrist roll is continuous: any twist runs in full
         rot.arm.move_to_joints(
             q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2
