@@ -22,6 +22,7 @@ SUBCOMMANDS = {
     "table": ("benchharness.cli.run", "table"),
     "compare": ("benchharness.cli.run", "compare"),
     "results": ("benchharness.cli.run", "results"),
+    "sweep": ("benchharness.cli.sweep", "sweep"),
 }
 
 
