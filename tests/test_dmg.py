@@ -11,11 +11,11 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 pytest.importorskip("networkx")
 
-from benchharness.strategies.dmg.config import DMGConfig, GripperConfig  # noqa: E402
+from benchharness.strategies.dmg.config import DMGConfig, DMGGripperModel  # noqa: E402
 from benchharness.strategies.dmg.graph import build_graph  # noqa: E402
 from benchharness.strategies.dmg.planner import Grasp, Rotate, Translate, plan  # noqa: E402
 
-L = GripperConfig().finger_length  # 35 mm
+L = DMGGripperModel().finger_length  # 35 mm
 
 
 def _box(extents, edge=0.003):
@@ -66,7 +66,7 @@ def test_opening_width_decides_which_faces_are_graspable(thin_box):
 def test_wider_box_needs_a_wider_gripper():
     m = _box((0.06, 0.1, 0.1), edge=0.004)
     assert not build_graph(m).admissible.any()
-    wide = build_graph(m, DMGConfig(gripper=GripperConfig(max_opening=0.07)))
+    wide = build_graph(m, DMGConfig(gripper=DMGGripperModel(max_opening=0.07)))
     on_x = np.abs(wide.patches.normals[:, 0]) > 0.99
     assert wide.admissible[on_x].any()
 

@@ -18,7 +18,7 @@ from typing import Generic, TypeVar
 
 import numpy as np
 
-from ._urdf import UrdfModel
+from ._urdf import ParsedUrdf
 from .interface import BackendError, BodyId, JointInfo
 
 __all__ = [
@@ -131,7 +131,7 @@ class BodyRecord:
     """What a backend knows about one body, engine handles aside (subclasses add those)."""
 
     name: str
-    urdf: UrdfModel | None = None
+    urdf: ParsedUrdf | None = None
     joints: list[JointInfo] = field(default_factory=list)  #: movable joints, URDF order
     fixed: bool = False  #: a fixed base (or a static body)
     drive: DriveState = field(default_factory=lambda: DriveState.zeros(0))

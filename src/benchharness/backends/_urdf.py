@@ -59,7 +59,10 @@ def _shape_volume_com_inertia(shape: Shape) -> tuple[float, np.ndarray, np.ndarr
 
 
 @dataclass(frozen=True)
-class MassProperties:
+class BodyInertial:
+    """A rigid body's mass, centre of mass and principal inertia, as the engines take them
+    (the object catalogue's published figures are :class:`benchharness.objects.MassProperties`)."""
+
     mass: float
     com: np.ndarray  #: body frame
     inertia_diag: np.ndarray  #: principal moments about the COM
@@ -75,7 +78,7 @@ def mass_properties(
     mass: float,
     com: Sequence[float] | None = None,
     inertia_diag: Sequence[float] | None = None,
-) -> MassProperties:
+) -> BodyInertial:
     """Uniform-density mass properties of a compound, overridden by ``com``/``inertia_diag``."""
     if not shapes:
         raise BackendError("a body needs at least one shape")
@@ -98,7 +101,7 @@ def mass_properties(
     if com is not None:
         c_body = np.asarray(com, dtype=float)
     if inertia_diag is not None:
-        return MassProperties(
+        return BodyInertial(
             float(mass), c_body, np.asarray(inertia_diag, dtype=float), np.array([0, 0, 0, 1.0])
         )
     w, vec = np.linalg.eigh(0.5 * (i_body + i_body.T))
@@ -107,13 +110,16 @@ def mass_properties(
     if np.allclose(
         i_body, np.diag(np.diag(i_body)), atol=1e-12 * max(1e-30, float(np.max(np.abs(i_body))))
     ):
-        return MassProperties(float(mass), c_body, np.diag(i_body).copy(), np.array([0, 0, 0, 1.0]))
-    return MassProperties(float(mass), c_body, w, Rotation.from_matrix(vec).as_quat())
+        return BodyInertial(float(mass), c_body, np.diag(i_body).copy(), np.array([0, 0, 0, 1.0]))
+    return BodyInertial(float(mass), c_body, w, Rotation.from_matrix(vec).as_quat())
 
 
 # -- URDF ---------------------------------------------------------------------
 @dataclass
-class UrdfModel:
+class ParsedUrdf:
+    """What the backends read of a URDF file (links, joints, masses); robots write theirs
+    with ``robots.urdf_builder.UrdfBuilder``."""
+
     path: Path
     root_link: str
     links: list[str]
@@ -181,7 +187,7 @@ def _req(el: ET.Element | None, attr: str, path: Path, what: str) -> str:
     return v
 
 
-def parse_urdf(path: str | Path) -> UrdfModel:
+def parse_urdf(path: str | Path) -> ParsedUrdf:
     path = Path(path)
     try:
         root = ET.parse(path).getroot()
@@ -245,7 +251,7 @@ def parse_urdf(path: str | Path) -> UrdfModel:
             "joints); drive those joints explicitly",
             stacklevel=3,
         )
-    model = UrdfModel(
+    model = ParsedUrdf(
         path=path, root_link=roots[0], links=links, joints=joints, mimic=mimic, masses=masses
     )
     model.movable = [j for j in joints if j.type in MOVABLE]

@@ -30,7 +30,7 @@ import pybullet as pb
 from ..geometry import Pose
 from . import PYBULLET_CAPABILITIES
 from ._bodies import BodyRecord, BodyTable, as_array, drive_command
-from ._urdf import MassProperties, ground_ray_fixup, mass_properties, parse_urdf
+from ._urdf import BodyInertial, ground_ray_fixup, mass_properties, parse_urdf
 from .interface import (
     Backend,
     BackendError,
@@ -432,7 +432,7 @@ class PyBulletBackend(Backend):
     ) -> BodyId:
         cid = self._cid
         shapes = list(shapes)
-        mp: MassProperties = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
+        mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         tmp: list[str] = []
         arrays = self._shape_arrays(shapes, tmp)  # mesh hulls are written to disk once, here
         if len(shapes) == 1:

@@ -33,7 +33,7 @@ from ..geometry import Pose
 from . import SAPIEN_CAPABILITIES
 from ._bodies import BodyRecord, BodyTable, as_array, drive_command
 from ._urdf import (
-    MassProperties,
+    BodyInertial,
     collision_only_copy,
     ground_ray_fixup,
     mass_properties,
@@ -266,7 +266,7 @@ class SapienBackend(Backend):
     ) -> BodyId:
         self._apply_global_config()
         shapes = list(shapes)
-        mp: MassProperties = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
+        mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         mat = self._material(friction)
         builder = self._scene.create_actor_builder()
         tmp: list[str] = []

@@ -33,7 +33,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-__all__ = ["Geom", "Link", "Joint", "UrdfModel", "shape_inertia", "composite_inertia"]
+__all__ = ["Geom", "Link", "Joint", "UrdfBuilder", "shape_inertia", "composite_inertia"]
 
 
 @dataclass(frozen=True)
@@ -252,7 +252,10 @@ class Joint:
 
 
 @dataclass
-class UrdfModel:
+class UrdfBuilder:
+    """A robot description being written: links and joints in, URDF text out
+    (the backends' reader of URDF files is ``backends._urdf.ParsedUrdf``)."""
+
     name: str
     header: str = ""
     links: list[Link] = field(default_factory=list)

@@ -18,7 +18,7 @@ import numpy as np
 if TYPE_CHECKING:
     from ..backends.interface import BodyId
 
-__all__ = ["PoseEstimate", "TrialRecorder", "pose_errors"]
+__all__ = ["LoggedEstimate", "TrialRecorder", "pose_errors"]
 
 
 def _jsonable(v: Any) -> Any:
@@ -54,7 +54,10 @@ def pose_errors(true_pose: Any, estimated_pose: Any) -> tuple[float, float]:
 
 
 @dataclass(frozen=True)
-class PoseEstimate:
+class LoggedEstimate:
+    """One logged belief of the cube pose beside the truth (a diagnostics row, not a filter state:
+    that is :class:`benchharness.sensors.PoseEstimate`)."""
+
     move_index: int
     t: float
     label: str
@@ -77,7 +80,7 @@ class TrialRecorder:
     clock: Callable[[], float] = lambda: 0.0
     first_contact_s: float | None = None
     events: list[dict[str, Any]] = field(default_factory=list)
-    estimates: list[PoseEstimate] = field(default_factory=list)
+    estimates: list[LoggedEstimate] = field(default_factory=list)
     watched: list[tuple[BodyId, BodyId | None]] = field(default_factory=list)
 
     # -- the score's anchor --------------------------------------------------------------
@@ -96,10 +99,10 @@ class TrialRecorder:
     # -- diagnostics ------------------------------------------------------------------------
     def pose_estimate(
         self, move_index: int, true_pose: Any, estimated_pose: Any, label: str = "regrasp"
-    ) -> PoseEstimate:
+    ) -> LoggedEstimate:
         """The cube pose the strategy believes vs the true (simulator) pose, e.g. at a regrasp."""
         pos, rot = pose_errors(true_pose, estimated_pose)
-        est = PoseEstimate(
+        est = LoggedEstimate(
             int(move_index),
             float(self.clock()),
             str(label),

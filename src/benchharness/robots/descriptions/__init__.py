@@ -10,13 +10,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from ..urdf_builder import UrdfModel
+from ..urdf_builder import UrdfBuilder
 
 __all__ = ["generators", "write_all"]
 
 
-def generators() -> dict[str, Callable[[], UrdfModel]]:
-    """Robot name -> function building its :class:`UrdfModel`."""
+def generators() -> dict[str, Callable[[], UrdfBuilder]]:
+    """Robot name -> function building its :class:`UrdfBuilder`."""
     from . import allegro, herb, pr2, pr2_gripper
 
     return {

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from ..urdf_builder import Geom, UrdfModel
+from ..urdf_builder import Geom, UrdfBuilder
 
 DEG = math.pi / 180.0
 SRC = "allegro_hand_description_right.xacro (simlabrobotics/allegro_hand_ros_v4)"
@@ -44,7 +44,7 @@ EFFORT = 0.7  # N m, Allegro v4 rated joint torque (Wonik datasheet)
 VELOCITY = 7.0  # rad/s (upstream <limit velocity>)
 
 
-def _finger(m: UrdfModel, n: int, y: float, z: float, roll: float) -> None:
+def _finger(m: UrdfBuilder, n: int, y: float, z: float, roll: float) -> None:
     base = 4 * n
     parent = "palm_link"
     origins = [
@@ -82,7 +82,7 @@ def _finger(m: UrdfModel, n: int, y: float, z: float, roll: float) -> None:
     _tip(m, base + 3, LINK_Z[3] - TIP_R)
 
 
-def _tip(m: UrdfModel, n: int, z: float) -> None:
+def _tip(m: UrdfBuilder, n: int, z: float) -> None:
     m.joint(
         f"joint_{n}_tip",
         "fixed",
@@ -99,7 +99,7 @@ def _tip(m: UrdfModel, n: int, z: float) -> None:
     )
 
 
-def _thumb(m: UrdfModel) -> None:
+def _thumb(m: UrdfBuilder) -> None:
     lo, hi = THUMB_LIMITS[0]
     m.joint(
         "joint_12",
@@ -155,8 +155,8 @@ def _thumb(m: UrdfModel) -> None:
     _tip(m, 15, THUMB_Z[2] - TIP_R)
 
 
-def build() -> UrdfModel:
-    m = UrdfModel("allegro_hand_right", header=__doc__ or "")
+def build() -> UrdfBuilder:
+    m = UrdfBuilder("allegro_hand_right", header=__doc__ or "")
     m.link(
         "palm_link",
         [Geom("box", (0.0408, 0.1130, 0.095), (-0.0093, 0.0, -0.0475))],

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 
-from ..urdf_builder import Geom, UrdfModel
+from ..urdf_builder import Geom, UrdfBuilder
 
 HERB_DESCRIPTION = "personalrobotics/herb_description@2604b90b3e89a9f1133355abbe2c9818509392ca"
 BARRETT_MODEL = "jhu-lcsr/barrett_model@b58cf4c0fbb0cd32fc0e8729f10a3d57d52715fc"
@@ -111,7 +111,7 @@ PROX_BOX = ((0.058, 0.016, 0.024), (0.037, 0.0, 0.0))
 DIST_BOX = ((BH_TIP_LEN - 0.003, 0.014, 0.022), ((BH_TIP_LEN + 0.003) / 2, 0.0, 0.0))
 
 
-def _wam(m: UrdfModel, side: str) -> None:
+def _wam(m: UrdfBuilder, side: str) -> None:
     s = side
     xyz, rpy = WAM_MOUNT[s]
     m.joint(
@@ -217,7 +217,7 @@ def _wam_link_geoms(i: int) -> list[Geom]:
     return [Geom("cylinder", (0.035, 0.02), (0.0, 0.0, 0.045))]  # j7 output flange
 
 
-def _hand(m: UrdfModel, s: str) -> None:
+def _hand(m: UrdfBuilder, s: str) -> None:
     p = f"{s}_bh"
     src = f"{BARRETT_MODEL} models/hand.urdf.xacro"
     m.link(
@@ -268,7 +268,7 @@ def _hand(m: UrdfModel, s: str) -> None:
     _finger(m, p, "3", f"{p}_palm_link", (BH_F3_FLEX, (math.pi / 2, 0.0, math.pi / 2)), src)
 
 
-def _finger(m: UrdfModel, p: str, f: str, parent: str, flex_origin, src: str) -> None:
+def _finger(m: UrdfBuilder, p: str, f: str, parent: str, flex_origin, src: str) -> None:
     m.joint(
         f"{p}_j{f}2_joint",
         "revolute",
@@ -325,8 +325,8 @@ def _finger(m: UrdfModel, p: str, f: str, parent: str, flex_origin, src: str) ->
     m.link(f"{p}_finger_{f}_tip", source="fingertip frame")
 
 
-def build() -> UrdfModel:
-    m = UrdfModel("herb", header=__doc__ or "")
+def build() -> UrdfBuilder:
+    m = UrdfBuilder("herb", header=__doc__ or "")
     m.link(
         "base_link",
         [Geom("box", (0.6, 0.5, 0.4), (-0.1, 0.0, 0.2))],

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 
-from ..urdf_builder import Geom, UrdfModel
+from ..urdf_builder import Geom, UrdfBuilder
 
 PR2_COMMIT = (
     "c36a5c9c8d5e97d2d53a7c75fa57a3257a7c63cc"  #: PR2/pr2_common commit the figures are read at
@@ -108,7 +108,7 @@ UPPER_ARM_INERTIA = {
 }
 
 
-def _arm(m: UrdfModel, side: str) -> None:
+def _arm(m: UrdfBuilder, side: str) -> None:
     reflect = 1 if side == "l" else -1
     s = side
     src = PR2_SRC
@@ -329,7 +329,7 @@ def _arm(m: UrdfModel, side: str) -> None:
     _gripper(m, s)
 
 
-def _gripper(m: UrdfModel, s: str) -> None:
+def _gripper(m: UrdfBuilder, s: str) -> None:
     m.joint(
         f"{s}_gripper_palm_joint",
         "fixed",
@@ -399,8 +399,8 @@ def _gripper(m: UrdfModel, s: str) -> None:
         )
 
 
-def build() -> UrdfModel:
-    m = UrdfModel(
+def build() -> UrdfBuilder:
+    m = UrdfBuilder(
         "pr2",
         header=__doc__ or "",
     )

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 
-from ..urdf_builder import UrdfModel
+from ..urdf_builder import UrdfBuilder
 from .pr2 import TCP_X, _gripper
 
 #: Stage travel (m) about the world origin; z from the floor up.
@@ -43,8 +43,8 @@ SIDE = "r"  #: the PR2 gripper used: right (link/joint names r_gripper_*)
 MOUNT_RPY = (0.0, math.pi / 2, 0.0)
 
 
-def build() -> UrdfModel:
-    m = UrdfModel("pr2_gripper", header=__doc__ or "")
+def build() -> UrdfBuilder:
+    m = UrdfBuilder("pr2_gripper", header=__doc__ or "")
     m.link(
         "stage_base", source="world-fixed stage origin (assumed positioning stage; no collision)"
     )
@@ -134,7 +134,7 @@ def build() -> UrdfModel:
     return m
 
 
-def _gripper_on(m: UrdfModel, parent: str) -> None:
+def _gripper_on(m: UrdfBuilder, parent: str) -> None:
     """The PR2 gripper (:func:`.pr2._gripper`) with its palm joint re-parented to ``parent``."""
     start = len(m.joints)
     _gripper(m, SIDE)

@@ -10,11 +10,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-__all__ = ["GripperConfig", "DMGConfig", "YUMI_SMART_GRIPPER"]
+__all__ = ["DMGGripperModel", "DMGConfig", "YUMI_SMART_GRIPPER"]
 
 
 @dataclass(frozen=True)
-class GripperConfig:
+class DMGGripperModel:
     """A parallel-jaw gripper reduced to what decides whether a grasp fits.
 
     Frame convention (also used for the task files' quaternions): ``z`` is the
@@ -50,7 +50,7 @@ class GripperConfig:
         return math.atan(self.friction_coefficient)
 
 
-YUMI_SMART_GRIPPER = GripperConfig()
+YUMI_SMART_GRIPPER = DMGGripperModel()
 
 
 @dataclass(frozen=True)
@@ -80,7 +80,7 @@ class DMGConfig:
     occupancy_pitch: float = 0.0015
     rotation_weight: float = 0.01
     secondary_jump_factor: float = 2.0
-    gripper: GripperConfig = field(default_factory=GripperConfig)
+    gripper: DMGGripperModel = field(default_factory=DMGGripperModel)
 
     def __post_init__(self) -> None:
         n = 360.0 / self.angle_step

@@ -136,7 +136,14 @@ def plan_to_region(dmg, initial, desired_contacts: np.ndarray):
     finger on the patch nearest the desired principal contact; the cheapest such state wins."""
     import networkx as nx
 
-    from .planner import NoPlanError, Plan, _final_grasp, _primitives, snap_grasp, surface_contacts
+    from .planner import (
+        DMGNoPathError,
+        DMGPath,
+        _final_grasp,
+        _primitives,
+        snap_grasp,
+        surface_contacts,
+    )
 
     t0 = time.perf_counter()
     start = snap_grasp(dmg, initial)
@@ -148,7 +155,7 @@ def plan_to_region(dmg, initial, desired_contacts: np.ndarray):
     pt = dmg.patches
     usable = np.flatnonzero(dmg.admissible.any(axis=1) & (pt.normals @ -z >= 0.5))
     if len(usable) == 0:
-        raise NoPlanError("no admissible state faces the desired region")
+        raise DMGNoPathError("no admissible state faces the desired region")
     patch = int(usable[np.argmin(np.linalg.norm(pt.centers[usable] - p, axis=1))])
     dist, paths = nx.single_source_dijkstra(dmg.graph, start.state, weight="weight")
     goals = [
@@ -171,7 +178,7 @@ def plan_to_region(dmg, initial, desired_contacts: np.ndarray):
     prims = _primitives(dmg, path, start.theta, theta_end)
     final = _final_grasp(dmg, end_patch, theta_end, start.principal)
     goal = snap_grasp(dmg, final, principal=start.principal)
-    return Plan(
+    return DMGPath(
         start=start,
         goal=goal,
         states=tuple(int(s) for s in path),
@@ -222,7 +229,7 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
     """One DMG trial on the simulator (see the module docstring)."""
     from ...objects import load_object
     from ..pivoting.rig import RigFailure, TableRig
-    from .planner import Grasp, NoPlanError, surface_contacts
+    from .planner import DMGNoPathError, Grasp, surface_contacts
 
     cfg = config or DMGExecConfig()
     ex = cfg.execution
@@ -252,7 +259,7 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
             )
         else:
             plan = planner.plan_task(_task_set(item), 0).plan
-    except NoPlanError as e:
+    except DMGNoPathError as e:
         return TrialOutcome(
             failure="unreachable",
             message=f"no DMG plan: {e}",

@@ -9,7 +9,7 @@ itself (``docs/dmg.md`` gives the reasoning):
 * the axis along which the two published contacts are separated is the
   grasped thickness, mapped to our thickness axis;
 * the remaining axes are matched so that, with the gripper convention of
-  :class:`~benchharness.strategies.dmg.config.GripperConfig` (palm at ``-x``),
+  :class:`~benchharness.strategies.dmg.config.DMGGripperModel` (palm at ``-x``),
   the palm of every published initial and desired grasp points over a
   nearby edge, i.e. the published grasps are collision-free on our mesh;
 * ``c_pub`` is the published point mapped to ``o_ours``: the midpoint of the
@@ -27,11 +27,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Placement", "PLACEMENTS", "placement_for"]
+__all__ = ["DMGPlacement", "PLACEMENTS", "placement_for"]
 
 
 @dataclass(frozen=True)
-class Placement:
+class DMGPlacement:
     """Rigid map from the published (real-YCB) frame of an object to ours."""
 
     object: str
@@ -90,22 +90,22 @@ def _spatula_rotation() -> tuple[tuple[float, float, float], ...]:
     return tuple(tuple(float(v) for v in row) for row in r)
 
 
-PLACEMENTS: dict[str, Placement] = {
-    "gelatin box": Placement(
+PLACEMENTS: dict[str, DMGPlacement] = {
+    "gelatin box": DMGPlacement(
         "gelatin box",
         ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),  # ours (x, y, z) = pub (z, x, y)
         (0.0, 0.0, -0.00115),
         (0.0, 0.0, 0.0),
         "published contacts 29.7 mm apart along pub z = our 28 mm x; pub x/y = our 85/73 mm y/z",
     ),
-    "cracker box": Placement(
+    "cracker box": DMGPlacement(
         "cracker box",
         _I,
         (-0.0005, 0.0, 0.0),
         (0.0, 0.0, 0.0),
         "published contacts 71 mm apart along pub x (real scan ~72 mm) = our 60 mm x",
     ),
-    "spatula": Placement(
+    "spatula": DMGPlacement(
         "spatula",
         _spatula_rotation(),
         (0.10, -0.1125, 0.0065),
@@ -115,7 +115,7 @@ PLACEMENTS: dict[str, Placement] = {
         f"tilted {SPATULA_TILT_DEG} deg about y so the published closing axis is normal to our blade "
         "(which slopes ~11 deg there, the scan ~20 deg)",
     ),
-    "potted meat can": Placement(
+    "potted meat can": DMGPlacement(
         "potted meat can",
         ((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),  # ours (x, y, z) = pub (y, -x, z)
         (-0.03, -0.0235, 0.041),
@@ -126,7 +126,7 @@ PLACEMENTS: dict[str, Placement] = {
 }
 
 
-def placement_for(name: str) -> Placement:
+def placement_for(name: str) -> DMGPlacement:
     key = " ".join(str(name).lower().replace("_", " ").split())
     if key not in PLACEMENTS:
         raise KeyError(

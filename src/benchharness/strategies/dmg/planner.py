@@ -1,7 +1,7 @@
 """Planning on the DMG: grasps in, primitive motions out (the paper's "Plan time").
 
 A grasp (two contact points and the gripper quaternion, gripper frame as in
-:class:`~benchharness.strategies.dmg.config.GripperConfig`) is mapped to a
+:class:`~benchharness.strategies.dmg.config.DMGGripperModel`) is mapped to a
 graph state: the *principal* finger is the contact whose outward normal best
 opposes the gripper's ``z`` axis; the state is the admissible (patch, angle)
 among the patches nearest that contact minimising ``distance +
@@ -33,15 +33,15 @@ __all__ = [
     "Translate",
     "Primitive",
     "SnappedGrasp",
-    "Plan",
+    "DMGPath",
     "snap_grasp",
     "surface_contacts",
     "plan",
-    "NoPlanError",
+    "DMGNoPathError",
 ]
 
 
-class NoPlanError(RuntimeError):
+class DMGNoPathError(RuntimeError):
     """The start grasp cannot be placed on the graph at all."""
 
 
@@ -108,7 +108,7 @@ class SnappedGrasp:
 
 
 @dataclass(frozen=True)
-class Plan:
+class DMGPath:
     """A DMG plan. ``reached_goal`` is False when the goal state is not
     connected to the start: the plan then ends at the connected state nearest
     the goal (by the snapping cost), the planner's best effort."""
@@ -213,7 +213,7 @@ def snap_grasp(
     facing = pt.normals @ -zg >= 0.5
     usable = np.flatnonzero(dmg.admissible.any(axis=1) & facing)
     if len(usable) == 0:
-        raise NoPlanError(
+        raise DMGNoPathError(
             "no admissible state faces the gripper (object too wide for the gripper?)"
         )
     d = np.linalg.norm(pt.centers[usable] - p0, axis=1)
@@ -300,7 +300,7 @@ def _miss(dmg: DMGraph, state: int, goal: SnappedGrasp) -> float:
     return float(gap + dmg.config.rotation_weight * abs(_wrap(k * step - theta)))
 
 
-def plan(dmg: DMGraph, initial: Grasp, desired: Grasp) -> Plan:
+def plan(dmg: DMGraph, initial: Grasp, desired: Grasp) -> DMGPath:
     """Plan from ``initial`` to ``desired`` on ``dmg`` (deterministic)."""
     import networkx as nx
 
@@ -324,7 +324,7 @@ def plan(dmg: DMGraph, initial: Grasp, desired: Grasp) -> Plan:
         theta_end = end_k * step
     prims = _primitives(dmg, path, start.theta, theta_end)
     final = _final_grasp(dmg, end_patch, theta_end, start.principal)
-    return Plan(
+    return DMGPath(
         start=start,
         goal=goal,
         states=tuple(int(s) for s in path),

@@ -16,14 +16,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .config import DMGConfig, GripperConfig
-from .placement import Placement, placement_for
+from .config import DMGConfig, DMGGripperModel
+from .placement import DMGPlacement, placement_for
 
 if TYPE_CHECKING:  # the planner module pulls in scipy/trimesh at call time only
-    from .planner import Plan
+    from .planner import DMGPath
 
 __all__ = [
-    "TaskPlan",
+    "DMGTaskPlan",
     "DMGPlanner",
     "ReachedGrasp",
     "results_for_grasps",
@@ -39,7 +39,7 @@ __all__ = [
 #: ~72 mm) depth, beyond the YuMi's 50 mm stroke, so the published run cannot
 #: have applied that limit; we allow 75 mm for that object only.
 PUBLISHED_TASK_CONFIGS: Mapping[str, DMGConfig] = {
-    "cracker box": DMGConfig(gripper=GripperConfig(max_opening=0.075)),
+    "cracker box": DMGConfig(gripper=DMGGripperModel(max_opening=0.075)),
 }
 
 #: Radius (m) of the geodesic disc around each desired contact that forms the
@@ -53,7 +53,7 @@ FINGER_PAD_RADIUS = 0.005
 
 
 @dataclass(frozen=True)
-class TaskPlan:
+class DMGTaskPlan:
     """One planned task. ``plan`` (and its grasps) are in our mesh frame;
     ``final_contacts``/``final_quaternion``/``final_pose`` in the task's
     (published) frame. ``graph_time_s`` is the DMG construction time of the
@@ -61,12 +61,12 @@ class TaskPlan:
 
     task_id: str
     object: str
-    plan: Plan
+    plan: DMGPath
     final_contacts: np.ndarray
     final_quaternion: np.ndarray
     graph_time_s: float
     plan_time_s: float
-    placement: Placement
+    placement: DMGPlacement
 
     @property
     def final_pose(self) -> np.ndarray:
@@ -126,16 +126,16 @@ class DMGPlanner:
             self._graphs[k] = build_graph(self.mesh_for(obj), self.config_for(obj))
         return self._graphs[k]
 
-    def placement(self, obj: str) -> Placement:
+    def placement(self, obj: str) -> DMGPlacement:
         try:
             return placement_for(obj)
         except KeyError:
             ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-            return Placement(
+            return DMGPlacement(
                 _key(obj), ident, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), "task assumed in our frame"
             )
 
-    def plan_task(self, tasks, i: int) -> TaskPlan:
+    def plan_task(self, tasks, i: int) -> DMGTaskPlan:
         """Plan row ``i`` of a :class:`~benchharness.inhand.records.TaskSet`.
 
         Needs ``initial_contact1/2`` and ``desired_contact1/2`` columns.
@@ -158,7 +158,7 @@ class DMGPlanner:
             pl.to_ours(tasks.contacts["desired"][i, :2]), pl.quat_to_ours(tasks.desired[i, 3:])
         )
         p = plan(dmg, ini, des)
-        return TaskPlan(
+        return DMGTaskPlan(
             task_id=str(tasks.task_id[i]),
             object=obj,
             plan=p,
@@ -169,7 +169,7 @@ class DMGPlanner:
             placement=pl,
         )
 
-    def plan_tasks(self, tasks) -> list[TaskPlan]:
+    def plan_tasks(self, tasks) -> list[DMGTaskPlan]:
         return [self.plan_task(tasks, i) for i in range(len(tasks))]
 
 
@@ -192,7 +192,7 @@ def results_for_grasps(
     """A :class:`ResultSet` for final grasps of ``tasks``; meshes go to ``out_dir/meshes``.
 
     One trial per task (the planner is deterministic). ``object_mesh`` is
-    our mesh placed in the task's frame (:meth:`.Placement.mesh_in_published`);
+    our mesh placed in the task's frame (:meth:`.DMGPlacement.mesh_in_published`);
     ``desired_region`` holds its vertices within :data:`DESIRED_REGION_RADIUS`
     (geodesic) of either desired contact (put on the mesh along the desired
     closing line, :func:`.planner.surface_contacts`); ``reached_links`` the two
@@ -262,7 +262,7 @@ def results_for_grasps(
 
 def results_from_plans(
     tasks,
-    plans: list[TaskPlan],
+    plans: list[DMGTaskPlan],
     planner: DMGPlanner,
     out_dir: str | Path,
     method: str = "DMG (benchharness)",
@@ -285,7 +285,7 @@ def results_from_plans(
 
 def write_dmg_results(
     tasks,
-    plans: list[TaskPlan],
+    plans: list[DMGTaskPlan],
     planner: DMGPlanner,
     path: str | Path,
     method: str = "DMG (benchharness)",

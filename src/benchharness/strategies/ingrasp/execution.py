@@ -63,7 +63,7 @@ import torch
 from scipy.spatial.transform import Rotation
 
 from .hand import DTYPE, FINGERS, TIP_LINKS, HandKinematics
-from .placement import Placement, object_surface_arrays, place_object
+from .placement import InGraspPlacement, object_surface_arrays, place_object
 from .planner import PlanResult
 from .problem import InGraspProblem
 from .rotations import pose_vector
@@ -210,7 +210,7 @@ class InGraspExecutor:
         self.config = config or ExecConfig()
 
     # ----------------------------------------------------------------- set-up geometry
-    def placement(self, problem: InGraspProblem, object_name: str) -> Placement:
+    def placement(self, problem: InGraspProblem, object_name: str) -> InGraspPlacement:
         """Where the (noise-free) object sits at ``q_0``; cached per task and object."""
         return _cached_placement(
             self.hand,
@@ -476,12 +476,12 @@ class InGraspExecutor:
         )
 
 
-_PLACEMENTS: dict[tuple, Placement] = {}
+_PLACEMENTS: dict[tuple, InGraspPlacement] = {}
 
 
 def _cached_placement(
     hand: HandKinematics, task_id: str, object_name: str, q_rest: tuple, fingers: tuple
-) -> Placement:
+) -> InGraspPlacement:
     from benchharness.objects import load_object
 
     key = (task_id, object_name, q_rest, fingers)

@@ -40,11 +40,11 @@ from scipy.spatial.transform import Rotation
 
 from .hand import DTYPE, FINGERS, TIP_LINKS, HandKinematics
 
-__all__ = ["Placement", "HandGeometry", "hand_geometry", "place_object"]
+__all__ = ["InGraspPlacement", "HandGeometry", "hand_geometry", "place_object"]
 
 
 @dataclass(frozen=True)
-class Placement:
+class InGraspPlacement:
     """The object's pose in the palm frame at the initial grasp and how well it fits."""
 
     pose: np.ndarray  #: 4x4, object (mesh / body) frame in the palm frame
@@ -151,7 +151,7 @@ def place_object(
     urdf: str | None = None,
     max_vertices: int = 400,
     refine: int = 4,
-) -> Placement:
+) -> InGraspPlacement:
     """Solve the object pose in the palm frame so ``fingers``' tips touch the surface at ``q16``.
 
     ``vertices``/``normals``: the object's surface mesh in its body frame
@@ -256,7 +256,7 @@ def place_object(
             best = (key[0], key[1], sol.x, r0)
     assert best is not None
     m = pose_of(best[2], best[3])
-    return Placement(
+    return InGraspPlacement(
         m,
         gaps(m),
         float(np.max(penetration(m, vertices) - clearance, initial=0.0).clip(min=0.0)),

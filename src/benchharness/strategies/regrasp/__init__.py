@@ -8,18 +8,18 @@ defines ``REGISTRATIONS``. Modules, each named for what it holds:
 * :mod:`.model` — work axis, grips, wrist range, costs (:class:`HandModel`);
 * :mod:`.translate` — notation (incl. slices and rotations) → centre-named face twists;
 * :mod:`.actions` — :class:`Pick`, :class:`Twist`, :class:`Regrasp`, :class:`Handover`,
-  :class:`Release` and the :class:`Plan`;
+  :class:`Release` and the :class:`RegraspPlan`;
 * :mod:`.search` — :func:`plan_sequence` (A*, optimal for the cost model) and :func:`naive_plan`;
 * :mod:`.executor` — :func:`execute`: the plan on the logical cube, every rule checked.
 
 See docs/planner.md.
 """
 
-from .actions import Action, Handover, Pick, Plan, Regrasp, Release, Twist
+from .actions import Action, Handover, Pick, Regrasp, RegraspPlan, Release, Twist
 from .executor import Execution, PlanError, TwistCheck, execute, twist_move
 from .model import CostModel, Grip, HandModel
 from .orientation import INITIAL_ORIENTATION, Orientation, all_orientations
-from .search import NoPlanError, naive_plan, plan_sequence
+from .search import RegraspNoPlanError, naive_plan, plan_sequence
 from .translate import FaceTwist, MoveTwists, logical_twists
 
 __all__ = [
@@ -32,10 +32,10 @@ __all__ = [
     "Handover",
     "INITIAL_ORIENTATION",
     "MoveTwists",
-    "NoPlanError",
+    "RegraspNoPlanError",
     "Orientation",
     "Pick",
-    "Plan",
+    "RegraspPlan",
     "PlanError",
     "Regrasp",
     "Release",

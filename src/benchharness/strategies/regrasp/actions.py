@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from .model import HandModel, Side
 from .orientation import Orientation
 
-__all__ = ["Action", "Handover", "Pick", "Plan", "Regrasp", "Release", "Twist"]
+__all__ = ["Action", "Handover", "Pick", "RegraspPlan", "Regrasp", "Release", "Twist"]
 
 
 @dataclass(frozen=True)
@@ -102,7 +102,7 @@ Action = Pick | Twist | Regrasp | Handover | Release
 
 
 @dataclass(frozen=True)
-class Plan:
+class RegraspPlan:
     """An action list for one move sequence, with the model it was made for and its cost."""
 
     moves: tuple[str, ...]  #: the input moves, as tokens

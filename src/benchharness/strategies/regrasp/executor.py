@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...cube import SOLVED, Move, apply
-from .actions import Handover, Pick, Plan, Regrasp, Release, Twist
+from .actions import Handover, Pick, Regrasp, RegraspPlan, Release, Twist
 from .model import (
     GIVER_ENDS,
     PICK_APPROACHES,
@@ -90,7 +90,7 @@ def twist_move(orientation: Orientation, axis: str, layer: int, quarter_turns: i
 
 
 def execute(
-    plan: Plan, initial_state: np.ndarray = SOLVED, model: HandModel | None = None
+    plan: RegraspPlan, initial_state: np.ndarray = SOLVED, model: HandModel | None = None
 ) -> Execution:
     """Run ``plan`` from ``initial_state`` (centre frame); raises :class:`PlanError` on any broken rule."""
     model = model or plan.model

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 from ...cube import Move
-from .actions import Action, Handover, Pick, Plan, Regrasp, Release, Twist
+from .actions import Action, Handover, Pick, Regrasp, RegraspPlan, Release, Twist
 from .executor import carry_turn
 from .model import (
     GRIPPERS,
@@ -39,14 +39,14 @@ from .model import (
 from .orientation import INITIAL_ORIENTATION, Orientation, all_orientations
 from .translate import FaceTwist, MoveTwists, logical_twists
 
-__all__ = ["NoPlanError", "naive_plan", "plan_sequence"]
+__all__ = ["RegraspNoPlanError", "naive_plan", "plan_sequence"]
 
 _SIDES: tuple[Side, ...] = GRIPPERS
 _HANDOVER_TURNS: tuple[tuple[str, int], ...] = (("z", 1), ("z", -1), ("x", 1), ("x", -1))
 _END = -1
 
 
-class NoPlanError(RuntimeError):
+class RegraspNoPlanError(RuntimeError):
     """The model admits no plan (cannot happen with the built-in models; guards custom ones)."""
 
 
@@ -125,7 +125,7 @@ def plan_sequence(
     moves: str | Iterable[Move | str],
     model: HandModel | None = None,
     initial: Orientation = INITIAL_ORIENTATION,
-) -> Plan:
+) -> RegraspPlan:
     """The cheapest plan for ``moves`` under ``model`` (A* over the whole sequence; deterministic)."""
     model = model or HandModel.pr2()
     mts = logical_twists(moves)
@@ -226,7 +226,7 @@ def plan_sequence(
                     act = (Handover, (other(side), side, t[0], t[1], _SIDES[s2], r2))
                     push((pos, o2, s2, r2), g_cost + costs.handover, node, act)
     if goal is None:
-        raise NoPlanError(f"no plan for {[m.token for m in mts]} under {model.name}")
+        raise RegraspNoPlanError(f"no plan for {[m.token for m in mts]} under {model.name}")
     actions: list[Action] = [Release()]
     cur: Node | None = goal
     while cur is not None:
@@ -234,7 +234,9 @@ def plan_sequence(
         actions.append(cls(*args))
         cur = parent
     actions.reverse()
-    return Plan(tuple(m.token for m in mts), tuple(actions), model, best[goal], initial, "optimal")
+    return RegraspPlan(
+        tuple(m.token for m in mts), tuple(actions), model, best[goal], initial, "optimal"
+    )
 
 
 def _start_roll(q: int, model: HandModel) -> int:
@@ -249,7 +251,7 @@ def naive_plan(
     moves: str | Iterable[Move | str],
     model: HandModel | None = None,
     initial: Orientation = INITIAL_ORIENTATION,
-) -> Plan:
+) -> RegraspPlan:
     """The baseline: one regrasp before every twist, without looking ahead.
 
     Pick from the left side (no carry turn), the right hand rotator; before
@@ -294,4 +296,4 @@ def naive_plan(
             actions.append(Twist(rotator, "y", side_layer(rotator), q, tw.face, tw.source))
             cost += c.twist_quarter * abs(q)
     actions.append(Release())
-    return Plan(tuple(m.token for m in mts), tuple(actions), model, cost, initial, "naive")
+    return RegraspPlan(tuple(m.token for m in mts), tuple(actions), model, cost, initial, "naive")
