@@ -26,7 +26,7 @@ import numpy as np
 
 from ..cube import get_tier, load_tiers
 from ..cube.tiers import UnknownTierError
-from ..metrics import mean_and_std, score_trials, summarize_scores
+from ..metrics import TrialScores, mean_and_std, score_trials, summarize_scores
 from .causes import TrialStatus
 from .published import TABLE_II, TABLE_III
 from .store import StoredTrial, group_by_run
@@ -254,6 +254,21 @@ def _inhand_arrays(trials: Sequence[StoredTrial]) -> dict[str, np.ndarray]:
     }
 
 
+def _score_stored(trials: Sequence[StoredTrial]) -> tuple[dict[str, np.ndarray], TrialScores]:
+    """The stored trials' pose arrays and their scores: one scoring path for Tables II, III and the summaries."""
+    a = _inhand_arrays(trials)
+    s = score_trials(
+        a["initial"],
+        a["desired"],
+        a["reached"],
+        setup=a["setup"],
+        dropped=a["dropped"],
+        plan_time_s=a["plan_time_s"],
+        exec_time_s=a["exec_time_s"],
+    )
+    return a, s
+
+
 def _scorable(trials: Iterable[StoredTrial]) -> tuple[list[StoredTrial], list[StoredTrial]]:
     """Trials with a pose outcome (scored, dropped or discarded) and the others (errors, timeouts...)."""
     scored, other = [], []
@@ -278,16 +293,7 @@ def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
     columns, col_of = _columns([t for t in trials if t.benchmark == "inhand"])
     rows: list[dict[str, Any]] = []
     if scored:
-        a = _inhand_arrays(scored)
-        s = score_trials(
-            a["initial"],
-            a["desired"],
-            a["reached"],
-            setup=a["setup"],
-            dropped=a["dropped"],
-            plan_time_s=a["plan_time_s"],
-            exec_time_s=a["exec_time_s"],
-        )
+        a, s = _score_stored(scored)
         labels = np.array([col_of[t.run_key].label for t in scored], dtype=object)
         for g in summarize_scores(s, {"method": labels}, ("method",), a["dropped"]):
             label = g.key[0]
@@ -344,16 +350,7 @@ def inhand_table3(
     if not scored:
         return []
     columns, col_of = _columns(scored)
-    a = _inhand_arrays(scored)
-    s = score_trials(
-        a["initial"],
-        a["desired"],
-        a["reached"],
-        setup=a["setup"],
-        dropped=a["dropped"],
-        plan_time_s=a["plan_time_s"],
-        exec_time_s=a["exec_time_s"],
-    )
+    a, s = _score_stored(scored)
     cols = {
         "method": np.array([col_of[t.run_key].label for t in scored], dtype=object),
         "task_id": np.array([t.outcome.get("task_id", "") for t in scored], dtype=object),
@@ -424,16 +421,7 @@ def inhand_box_plot(trials: Sequence[StoredTrial], path, *, title: str | None = 
             "no in-hand trials with a reached pose in the selection (benchharness run --task inhand-...)"
         )
     _, col_of = _columns(scored)
-    a = _inhand_arrays(scored)
-    s = score_trials(
-        a["initial"],
-        a["desired"],
-        a["reached"],
-        setup=a["setup"],
-        dropped=a["dropped"],
-        plan_time_s=a["plan_time_s"],
-        exec_time_s=a["exec_time_s"],
-    )
+    a, s = _score_stored(scored)
     cols = {
         "object": np.array([t.outcome.get("object", "") or "?" for t in scored], dtype=object),
         "method": np.array([col_of[t.run_key].label for t in scored], dtype=object),
