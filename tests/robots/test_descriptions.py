@@ -13,7 +13,8 @@ from benchharness.robots.descriptions import write_all
 from benchharness.robots.urdf_builder import Geom, composite_inertia, shape_inertia
 
 NAMES = ("pr2", "herb", "allegro")
-DOF = {"pr2": 19, "herb": 30, "allegro": 16}
+#: movable joints of each URDF (the PR2 has 19 driven ones and 4 four-bar fingertip joints that follow)
+DOF = {"pr2": 23, "herb": 30, "allegro": 16}
 
 
 def _root(name):

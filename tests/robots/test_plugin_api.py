@@ -19,7 +19,7 @@ def test_builtins_registered_with_meta(manager):
         item = manager.get("robot", name)
         assert item.distribution == "benchharness" and item.meta["dof"] == dof
         r = item.create()
-        assert r.dof == dof and sorted(r.groups()) == sorted(item.meta["groups"])
+        assert r.driven_dof == dof and sorted(r.groups()) == sorted(item.meta["groups"])
 
 
 def _renamed_pr2(tmp_path):

@@ -18,7 +18,7 @@ from benchharness.robots.pr2_gripper import stage_joints_for
 def test_description_is_physical_and_cited():
     root = ET.parse(robots_dir() / "pr2_gripper" / "pr2_gripper.urdf").getroot()
     movable = [j for j in root.findall("joint") if j.get("type") != "fixed"]
-    assert len(movable) == 8  # 3 prismatic + 3 wrist + 2 fingers
+    assert len(movable) == 10  # 3 prismatic + 3 wrist + 2 fingers + 2 four-bar fingertips
     for link in root.findall("link"):
         i = link.find("inertial/inertia")
         d = np.array([float(i.get(k)) for k in ("ixx", "iyy", "izz")])

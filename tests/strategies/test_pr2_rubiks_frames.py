@@ -110,19 +110,23 @@ def test_zero_error_config():
 
 
 def test_pad_spans_give_the_intended_slabs():
-    """The 35 mm pad centred on the tool frame: rotator on the outer slab only, holder on outer + middle."""
-    from benchharness.robots.descriptions.pr2 import PAD_SIZE
+    """The 36 mm pad, set back on the four-bar arc at the 57 mm grip: rotator on the outer slab only,
+    holder on outer + middle with half a cubie of margin (the pad geometry from pr2_description)."""
+    from benchharness.robots.descriptions.pr2 import PAD_SIZE, pad_setback
 
     cfg = PR2RubiksConfig()
     half_pad, slab_edge, face = PAD_SIZE[0] / 2, 0.057 / 6, 0.0285
-    assert cfg.rotator_offset - half_pad > slab_edge + 0.005  # inner end clear of the middle slab
-    assert cfg.holder_offset - half_pad < slab_edge - 0.009  # half a cubie onto the middle slab
-    assert (
-        cfg.holder_offset - half_pad > -slab_edge + 0.009
-    )  # and half a cubie short of the far slab
-    assert (
-        cfg.rotator_offset + half_pad > face and cfg.holder_offset + half_pad >= face - 1e-9
-    )  # to the face
+    back = pad_setback(0.057)
+    assert back == pytest.approx(0.0047, abs=0.0002)  # 4.7 mm behind the tool frame at 57 mm
+
+    def inner(offset):  # the pad's end nearest the cube centre, from the centre
+        return offset + back - half_pad
+
+    assert inner(cfg.rotator_offset) > slab_edge + 0.005  # inner end clear of the middle slab
+    assert inner(cfg.holder_offset) < slab_edge - 0.009  # half a cubie onto the middle slab
+    assert inner(cfg.holder_offset) > -slab_edge + 0.009  # and half a cubie short of the far slab
+    for off in (cfg.rotator_offset, cfg.holder_offset):
+        assert off + back + half_pad > face  # the pad reaches past the face
 
 
 def test_side_pick_plans_execute_on_the_logical_cube():

@@ -138,7 +138,7 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
     data = {
         "name": rob.name,
         "backend": backend_name,
-        "dof": rob.dof,
+        "dof": rob.driven_dof,
         "mass_kg": mass,
         "urdf": str(rob.urdf_path),
         "groups": {k: list(v) for k, v in rob.groups().items()},
@@ -171,7 +171,8 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
         return
     con = rich_console()
     con.print(
-        f"[bold]{rob.name}[/bold] on {backend_name}: {rob.dof} DOF, {mass:.2f} kg, {rob.urdf_path}"
+        f"[bold]{rob.name}[/bold] on {backend_name}: {rob.driven_dof} DOF ({rob.dof} joints), "
+        f"{mass:.2f} kg, {rob.urdf_path}"
     )
     t = Table(title="joints (SI units; home = home configuration)")
     for col in ("joint", "type", "lower", "upper", "max vel", "max effort", "home"):

@@ -22,7 +22,14 @@ import numpy as np
 
 from ..geometry import Pose
 
-__all__ = ["ArmConfig", "GripperConfig", "RobotConfig", "gains_from_effort", "robot_meta"]
+__all__ = [
+    "ArmConfig",
+    "FingertipLinkage",
+    "GripperConfig",
+    "RobotConfig",
+    "gains_from_effort",
+    "robot_meta",
+]
 
 
 @dataclass(frozen=True)
@@ -44,6 +51,43 @@ class ArmConfig:
     gravity_carried: bool = (
         False  #: gravity torque is carried by a counterbalance, not by the motors (PR2)
     )
+
+
+@dataclass(frozen=True)
+class FingertipLinkage:
+    """A fingertip joint that a parallelogram linkage ties to its finger's lateral joint.
+
+    Why: a four-bar finger (the PR2's) moves its pad on a circular arc, so the
+    pad slides along the approach as the gripper opens — a nonlinear mimic
+    relation that no engine's joint drives express (PhysX has no mimic joints
+    at all). The model gives each fingertip a prismatic ``follower`` joint along
+    the approach, re-aimed every control tick at the arc position of the
+    measured ``leader`` (lateral) joint: with the leader at ``q`` the real
+    fingertip frame sits ``radius * sin(angle) = q + lateral_offset`` out, and
+    the follower's value is ``radius * cos(angle)`` minus its value closed
+    (``q + lateral_offset = closed_offset``).
+    """
+
+    follower: str  #: the fingertip's prismatic joint along the approach
+    leader: str  #: the finger's lateral joint (a joint of the gripper)
+    radius: float  #: m, distance of the fingertip frame from the real finger's pivot
+    lateral_offset: float  #: m, added to the leader's value to give the lateral arm of the arc
+    closed_offset: float  #: m, that lateral arm where the follower reads 0
+    #: PD gains of the follower (N/m, N s/m): stiff, a stand-in for the rigid linkage (a 5 N load along
+    #: the approach moves the pad 0.25 mm); its force cap is the joint's URDF effort
+    stiffness: float = 2.0e4
+    damping: float = 200.0
+
+    def target(self, q_leader: float) -> float:
+        r = self.radius
+        s = min(r, max(-r, q_leader + self.lateral_offset))
+        return float(np.sqrt(r * r - s * s) - np.sqrt(r * r - self.closed_offset**2))
+
+    def rate(self, q_leader: float) -> float:
+        """d target / d q_leader: the follower's velocity per unit leader velocity."""
+        r = self.radius
+        s = min(0.999 * r, max(-0.999 * r, q_leader + self.lateral_offset))
+        return float(-s / np.sqrt(r * r - s * s))
 
 
 @dataclass(frozen=True)
@@ -78,9 +122,17 @@ class GripperConfig:
     #: (follower joint, leader joint, ratio): the follower tracks ``ratio * measured leader`` while the
     #: leader moves, and its own coupled target once the leader stalls (the BarrettHand's breakaway).
     follow: tuple[tuple[str, str, float], ...] = ()
+    #: fingertip joints that follow their finger's lateral joint on a linkage's arc (not in ``joints``:
+    #: the actuators, forces and openings stay those of ``joints``)
+    linkages: tuple[FingertipLinkage, ...] = ()
 
     def joint_targets(self, u: Sequence[float]) -> np.ndarray:
         return np.asarray(self.coupling, dtype=float) @ np.asarray(u, dtype=float)
+
+    @property
+    def driven_joints(self) -> tuple[str, ...]:
+        """Every joint this hand drives: ``joints`` and the linkages' fingertip joints."""
+        return self.joints + tuple(k.follower for k in self.linkages)
 
 
 @dataclass(frozen=True)
@@ -153,9 +205,12 @@ class RobotConfig:
                 joints=tuple(j(n) for n in h.joints),
                 finger_links=tuple(lk(n) for n in h.finger_links),
                 tcp_link=lk(h.tcp_link),
+                linkages=tuple(
+                    replace(k, follower=j(k.follower), leader=j(k.leader)) for k in h.linkages
+                ),
             )
             for h in self.grippers
-            if all(j(n) for n in h.joints)
+            if all(j(n) for n in h.driven_joints)
         )
         extra = {k: tuple(j(n) for n in v if j(n)) for k, v in self.extra_groups.items()}
         gains = {j(k): v for k, v in self.extra_gains.items() if j(k)}

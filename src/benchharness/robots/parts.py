@@ -367,6 +367,10 @@ class Gripper:
         self._force = np.asarray(config.force_limit, dtype=float)
         self._targets = config.joint_targets(self.command)
         self.lower, self.upper = robot.joint_limits(config.joints)
+        self._link_sent: np.ndarray | None = None  # fingertip targets last sent (linkages)
+        self._link_cb: tuple[object, int] | None = (
+            None  # (backend, step-callback handle) while moving
+        )
 
     @property
     def name(self) -> str:
@@ -400,9 +404,59 @@ class Gripper:
             damping=list(self.config.damping),
             force_limit=self._force.tolist(),
         )
+        self._link_sent = None
+        self._aim_linkages()
+
+    def _aim_linkages(self) -> None:
+        """Aim each linkage's fingertip at the arc position of its finger's measured lateral joint.
+
+        The velocity target is the arc's slope times the finger's measured
+        velocity: without it the fingertip trails its finger by the PD's lag
+        (measured: 5 mm at a free close on PyBullet), then catches up once the
+        pads touch and drags the held object along the approach. While a
+        finger moves, the fingertips are re-aimed after every physics step (a
+        Backend step callback, removed once the fingers rest): re-aimed only
+        each control tick, a fingertip overshot its finger's stop at contact
+        by up to a tick's travel (2.4 mm). At rest nothing is sent unless a
+        target moved (0.1 um): holding still is most of a trial.
+        """
+        links = self.config.linkages
+        be = self.robot.backend
+        if not links or be is None or self.robot.body is None:
+            return
+        leaders = [k.leader for k in links]
+        pos = self.robot.joint_positions(leaders)
+        vel = self.robot.joint_velocities(leaders)
+        t = np.array([k.target(float(p)) for k, p in zip(links, pos)])
+        v = np.array([k.rate(float(p)) * float(w) for k, p, w in zip(links, pos, vel)])
+        moving = bool(np.max(np.abs(vel)) > 1e-4)
+        if moving and (self._link_cb is None or self._link_cb[0] is not be):
+            self._link_cb = (be, be.add_step_callback(self._aim_linkages))
+        elif not moving and self._link_cb is not None:
+            if self._link_cb[0] is be:
+                be.remove_step_callback(self._link_cb[1])
+            self._link_cb = None
+        if (
+            not moving
+            and self._link_sent is not None
+            and np.max(np.abs(t - self._link_sent)) < 1e-7
+        ):
+            return
+        self._link_sent = None if moving else t
+        names = [k.follower for k in links]
+        be.set_joint_targets(
+            self.robot.body,
+            t,
+            v,
+            joints=names,
+            stiffness=[k.stiffness for k in links],
+            damping=[k.damping for k in links],
+            force_limit=[self.robot.urdf_joints[n].effort for n in names],
+        )
 
     def update(self) -> None:
         """Re-aim follower joints (called every control tick while the robot steps)."""
+        self._aim_linkages()
         if not self.config.follow or self.robot.body is None:
             return
         pos = self.robot.joint_positions(self.joints)

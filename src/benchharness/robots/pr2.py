@@ -8,13 +8,25 @@ from typing import TYPE_CHECKING
 
 from ..geometry import Pose
 from ..paths import robots_dir
-from .config import ArmConfig, GripperConfig, RobotConfig, gains_from_effort
-from .descriptions.pr2 import FINGER_TRAVEL
+from .config import ArmConfig, FingertipLinkage, GripperConfig, RobotConfig, gains_from_effort
+from .descriptions.pr2 import (
+    FINGER_RADIUS,
+    FINGER_TRAVEL,
+    FINGER_Y,
+    PAD_FACE_Y,
+    PAD_GAP,
+)
 
 if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
     from .robot import Robot
 
-__all__ = ["PR2_FULL_URDF_LINK_MAP", "PR2_FULL_URDF_JOINT_MAP", "pr2_config", "make_pr2"]
+__all__ = [
+    "PR2_FULL_URDF_LINK_MAP",
+    "PR2_FULL_URDF_JOINT_MAP",
+    "pr2_config",
+    "pr2_gripper_part",
+    "make_pr2",
+]
 
 ARM_JOINTS = (
     "shoulder_pan_joint",
@@ -44,12 +56,50 @@ HOME_ARM = {
 #: ``l_gripper_joint`` with mimic fingers, which our two-prismatic-finger gripper part cannot drive,
 #: so the grippers are dropped ("") there; arms, torso and TCP frames work unchanged.
 PR2_FULL_URDF_JOINT_MAP: Mapping[str, str] = {
-    f"{s}_gripper_{f}_finger_joint": "" for s in "lr" for f in "lr"
+    f"{s}_gripper_{f}_finger{part}_joint": "" for s in "lr" for f in "lr" for part in ("", "_tip")
 }
 PR2_FULL_URDF_LINK_MAP: Mapping[str, str] = {
     "l_gripper_tcp": "l_gripper_tool_frame",
     "r_gripper_tcp": "r_gripper_tool_frame",
 }
+
+
+def pr2_gripper_part(s: str, name: str, grip_force: float = 20.0) -> GripperConfig:
+    """The PR2 gripper on side ``s`` (``"l"``/``"r"``): one half-opening actuator, force in N per finger.
+
+    The two lateral finger joints take the command; each fingertip follows its
+    finger on the four-bar's arc (:class:`FingertipLinkage`, figures in
+    :mod:`.descriptions.pr2`), so the pads slide back along the approach as the
+    gripper opens, as the real ones do.
+    """
+    lateral = PAD_GAP + PAD_FACE_Y - FINGER_Y  # leader value 0 -> the real tip's lateral arm
+    linkages = tuple(
+        FingertipLinkage(
+            follower=f"{s}_gripper_{f}_finger_tip_joint",
+            leader=f"{s}_gripper_{f}_finger_joint",
+            radius=FINGER_RADIUS,
+            lateral_offset=lateral,
+            closed_offset=PAD_FACE_Y - FINGER_Y,
+        )
+        for f in "lr"
+    )
+    return GripperConfig(
+        name=name,
+        joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
+        actuators=("half_opening",),
+        coupling=((1.0,), (1.0,)),
+        open=(FINGER_TRAVEL,),
+        closed=(0.0,),
+        grasp_actuators=("half_opening",),
+        stiffness=(2000.0, 2000.0),
+        damping=(40.0, 40.0),
+        force_limit=(grip_force, grip_force),
+        # the pads (one link per finger, left first): where the gripper touches what it holds
+        finger_links=(f"{s}_gripper_l_finger_tip_link", f"{s}_gripper_r_finger_tip_link"),
+        tcp_link=f"{s}_gripper_tcp",
+        kind="parallel",
+        linkages=linkages,
+    )
 
 
 def pr2_config(
@@ -72,23 +122,7 @@ def pr2_config(
                 gravity_carried=True,
             )
         )
-        grippers.append(
-            GripperConfig(
-                name=f"{side}_gripper",
-                joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
-                actuators=("half_opening",),
-                coupling=((1.0,), (1.0,)),
-                open=(FINGER_TRAVEL,),
-                closed=(0.0,),
-                grasp_actuators=("half_opening",),
-                stiffness=(2000.0, 2000.0),
-                damping=(40.0, 40.0),
-                force_limit=(20.0, 20.0),
-                finger_links=(f"{s}_gripper_l_finger_link", f"{s}_gripper_r_finger_link"),
-                tcp_link=f"{s}_gripper_tcp",
-                kind="parallel",
-            )
-        )
+        grippers.append(pr2_gripper_part(s, f"{side}_gripper"))
         sign = 1.0 if s == "l" else -1.0
         for j, v in HOME_ARM.items():
             mirrored = j in (

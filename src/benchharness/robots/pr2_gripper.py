@@ -17,9 +17,9 @@ from scipy.spatial.transform import Rotation
 
 from ..geometry import Pose
 from ..paths import robots_dir
-from .config import ArmConfig, GripperConfig, RobotConfig
-from .descriptions.pr2 import FINGER_TRAVEL
+from .config import ArmConfig, RobotConfig
 from .descriptions.pr2_gripper import MOUNT_RPY, SIDE, STAGE_EFFORT, WRIST_EFFORT
+from .pr2 import pr2_gripper_part
 
 if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
     from .robot import Robot
@@ -74,21 +74,7 @@ def pr2_gripper_config(base_pose: Pose | None = None, grip_force: float = 20.0) 
         damping=(0.1 * k_lin,) * 3 + (0.1 * k_rot,) * 3,
         velocity_scale=0.5,
     )
-    grip = GripperConfig(
-        name="gripper",
-        joints=(f"{s}_gripper_l_finger_joint", f"{s}_gripper_r_finger_joint"),
-        actuators=("half_opening",),
-        coupling=((1.0,), (1.0,)),
-        open=(FINGER_TRAVEL,),
-        closed=(0.0,),
-        grasp_actuators=("half_opening",),
-        stiffness=(2000.0, 2000.0),
-        damping=(40.0, 40.0),
-        force_limit=(grip_force, grip_force),
-        finger_links=(f"{s}_gripper_l_finger_link", f"{s}_gripper_r_finger_link"),
-        tcp_link=f"{s}_gripper_tcp",
-        kind="parallel",
-    )
+    grip = pr2_gripper_part(s, "gripper", grip_force)
     return RobotConfig(
         name="pr2-gripper",
         urdf=robots_dir() / "pr2_gripper" / "pr2_gripper.urdf",

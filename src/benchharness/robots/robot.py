@@ -44,6 +44,12 @@ class Robot:
         self.joint_names: list[str] = [j.name for j in joints]
         self.link_names: list[str] = read_links(self.urdf_path)
         missing = [j for g in config.groups().values() for j in g if j not in self.urdf_joints]
+        missing += [
+            k.follower
+            for g in config.grippers
+            for k in g.linkages
+            if k.follower not in self.urdf_joints
+        ]
         if missing:
             raise ValueError(
                 f"robot {config.name!r}: joints {missing} are not movable joints of {self.urdf_path}"
@@ -66,7 +72,13 @@ class Robot:
 
     @property
     def dof(self) -> int:
+        """Movable joints of the model (a linkage's fingertip joints included)."""
         return len(self.joint_names)
+
+    @property
+    def driven_dof(self) -> int:
+        """Joints the robot's groups command: :attr:`dof` less the fingertips a linkage moves."""
+        return len({j for names in self.groups().values() for j in names})
 
     def groups(self) -> dict[str, tuple[str, ...]]:
         return self.config.groups()
@@ -110,7 +122,21 @@ class Robot:
             default.update(zip(g.joints, g.config.joint_targets(g.config.open)))
         lo, hi = self.joint_limits()
         q = [float(self.config.home.get(n, default.get(n, 0.0))) for n in self.joint_names]
-        return np.clip(np.array(q), lo, hi)
+        return self.with_linkages(np.clip(np.array(q), lo, hi))
+
+    def with_linkages(self, q: np.ndarray) -> np.ndarray:
+        """``q`` with every linkage's fingertip joint where its finger's lateral joint puts it.
+
+        Why: a linkage is rigid, so a configuration that sets the fingers (home, a
+        spawn pose) must carry the fingertips along, not leave them to catch up.
+        """
+        q = np.array(q, dtype=float)
+        for g in self.config.grippers:
+            for k in g.linkages:
+                q[self.joint_names.index(k.follower)] = k.target(
+                    float(q[self.joint_names.index(k.leader)])
+                )
+        return q
 
     def describe(self) -> dict:
         return {
@@ -128,6 +154,7 @@ class Robot:
             g.update({j: (k, d) for j, k, d in zip(a.joints, a.stiffness, a.damping)})
         for h in self.config.grippers:
             g.update({j: (k, d) for j, k, d in zip(h.joints, h.stiffness, h.damping)})
+            g.update({k.follower: (k.stiffness, k.damping) for k in h.linkages})
         g.update(dict(self.config.extra_gains))
         for n, j in self.urdf_joints.items():
             if n not in g:
@@ -153,7 +180,7 @@ class Robot:
         self._base_rot = pose.rotation.as_matrix()
         self._gravity = None  # built on first use, only for backends without gravity_torques
         self._gcache = None
-        q0 = self.home() if q is None else np.asarray(q, dtype=float)
+        q0 = self.home() if q is None else self.with_linkages(np.asarray(q, dtype=float))
         backend.set_joint_positions(self.body, q0)
         self._targets = q0.copy()
         self.hold()
@@ -182,7 +209,7 @@ class Robot:
     def _gravity_joints(self) -> list[str]:
         """Every joint but the grippers' (a new list each call; the names are computed once)."""
         if self._gj is None:
-            grip = {j for g in self.config.grippers for j in g.joints}
+            grip = {j for g in self.config.grippers for j in g.driven_joints}
             self._gj = tuple(j for j in self.joint_names if j not in grip)
         return list(self._gj)
 

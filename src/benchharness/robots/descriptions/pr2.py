@@ -70,19 +70,110 @@ def _soft(key: str, lower: float, upper: float) -> dict[str, float]:
     }
 
 
-#: Gripper figures.
-GRIPPER_MAX_OPENING = (
-    0.09  # m; PR2 gripper opens to ~90 mm (l_gripper_joint upper 0.088 in pr2_description)
+#: Gripper figures. The real finger is a parallelogram four-bar (pr2_description
+#: gripper_v0/gripper.urdf.xacro): ``*_l_finger_joint`` turns the proximal link by theta about z at
+#: FINGER_PIVOT, and ``*_l_finger_tip_joint`` (mimic +1, axis -z) turns the fingertip back by theta at
+#: FINGER_TO_TIP along it, so the fingertip stays parallel to the palm while its origin travels on a
+#: circle of radius FINGER_RADIUS about the pivot. We model exactly that pad motion with two prismatic
+#: joints per finger (see :func:`_gripper`).
+GRIPPER_MAX_OPENING = 0.09  # m; l_gripper_joint upper="0.09" (gripper_v0/gripper.urdf.xacro)
+GRIPPER_UPPER_ANGLE = (
+    0.548  # rad; gripper_upper_angle (finger joint upper limit, gripper.urdf.xacro)
 )
 PAD_GAP = 0.001  # m; each pad's inner face sits this far out from the finger joint value (pads never interpenetrate)
 FINGER_TRAVEL = (GRIPPER_MAX_OPENING - 2 * PAD_GAP) / 2  # per finger
-PAD_SIZE = (
-    0.035,
-    0.006,
-    0.022,
-)  # m (along approach, thickness, height): PR2 fingertip pad ~22 mm tall; 35 mm long covers <= 2 of the 19 mm cube slabs
 TCP_X = 0.18  # m; l_gripper_tool_frame origin xyz="0.18 0 0" (pr2_description gripper_v0/gripper.urdf.xacro)
-FINGER_X = 0.07691  # m; l_gripper_l_finger_joint origin x (gripper_v0/gripper.urdf.xacro)
+FINGER_X = 0.07691  # m; l_gripper_l_finger_joint origin x (palm_to_finger_x, gripper_v0/gripper.urdf.xacro)
+FINGER_Y = 0.01  # m; l_gripper_l_finger_joint origin y (gripper_v0/gripper.urdf.xacro)
+#: l_gripper_l_finger_tip_joint origin in the proximal link: finger_to_finger_tip_x, 0.00495 (gripper.urdf.xacro)
+FINGER_TO_TIP = (0.09137, 0.00495)
+FINGER_RADIUS = math.hypot(
+    *FINGER_TO_TIP
+)  # 0.091504 m: the transmission's r = 91.5 mm (pr2.urdf.xacro)
+#: The fingertip pad (meshes/gripper_v0/finger_tip_pad2_l.stl, in the fingertip frame): x -0.00475..0.03125,
+#: inner face at y = -0.01495 (so the faces meet at theta = 0, the closed gripper: 0.01 + 0.00495 - 0.01495),
+#: z -0.0115..0.0115 (bounds read with trimesh from the file at the commit above).
+PAD_FACE_Y = 0.01495
+PAD_CENTRE_X = (0.03125 - 0.00475) / 2  # 0.01325 m in the fingertip frame
+PAD_SIZE = (
+    0.036,
+    0.006,
+    0.023,
+)  # m (along approach, thickness, height): the pad mesh's 36 x 23 mm face; 6 mm of fingertip behind it
+#: Published fingertip inertial (l/r_gripper_*_finger_tip_link, gripper.urdf.xacro): our fingertip link
+#: frame is the real one (the same origin and, the linkage being a parallelogram, the same orientation).
+TIP_MASS = 0.04419
+TIP_COM = {"l": (0.00423, 0.00284, 0.0), "r": (0.00423, -0.00284, 0.0)}
+TIP_INERTIA = {
+    "l": (0.00000837047, 0.00000583632, 0.0, 0.00000987067, 0.0, 0.00001541768),
+    "r": (0.00000837047, -0.00000583632, 0.0, 0.00000987067, 0.0, 0.00001541768),
+}
+FINGER_MASS = {"l": 0.17126, "r": 0.17389}  # kg, l/r_gripper_*_finger_link (gripper.urdf.xacro)
+
+
+def finger_angle(half_opening: float) -> float:
+    """The real finger joint angle (rad) at which each pad face is ``half_opening`` from the midline."""
+    s = (half_opening + PAD_FACE_Y - FINGER_Y) / FINGER_RADIUS
+    return math.asin(max(-1.0, min(1.0, s))) - math.atan2(FINGER_TO_TIP[1], FINGER_TO_TIP[0])
+
+
+def tip_x(half_opening: float) -> float:
+    """Fingertip-frame origin along the approach (palm frame, m) with the pads ``half_opening`` out.
+
+    The tip origin is FINGER_RADIUS from the pivot at angle ``theta + phi``; its lateral
+    coordinate ``FINGER_Y + R sin(theta + phi) = half_opening + PAD_FACE_Y`` fixes the angle.
+    """
+    s = (half_opening + PAD_FACE_Y - FINGER_Y) / FINGER_RADIUS
+    return FINGER_X + FINGER_RADIUS * math.sqrt(max(0.0, 1.0 - s * s))
+
+
+def pad_setback(opening: float) -> float:
+    """How far (m) the pads' centre sits behind the tool frame with the pads ``opening`` apart.
+
+    -1.5 mm (in front) closed, 4.7 mm at a 57 mm grip, 13.2 mm at the 90 mm opening: the four-bar's
+    arc. Strategies that place a pad on part of an object use this, not the tool frame.
+    """
+    return TCP_X - (tip_x(opening / 2.0) + PAD_CENTRE_X)
+
+
+BAR_X0 = FINGER_X + 0.02  # m: the finger bar's palm end (a stand-in for the proximal link's shape)
+BAR_SIZE_YZ = (0.008, 0.02)  # m
+
+
+def _bar_length() -> float:
+    """The bar reaches the fully open pad's back end (it rides the lateral joint only)."""
+    return tip_x(FINGER_TRAVEL + PAD_GAP) + PAD_CENTRE_X - PAD_SIZE[0] / 2 - BAR_X0
+
+
+def finger_boxes(
+    opening: float,
+) -> list[tuple[tuple[float, float, float], tuple[float, float, float]]]:
+    """(centre, size) in the palm frame of each pad and finger bar with the pads ``opening`` apart.
+
+    The collision geometry :func:`_gripper` writes, placed at an opening: for planners that must
+    keep the fingers clear of something before commanding them.
+    """
+    h = opening / 2.0
+    x_tip = tip_x(h)
+    bar = _bar_length()
+    out = []
+    for sign in (1.0, -1.0):
+        y_tip = sign * (h + PAD_FACE_Y)
+        out.append(
+            ((x_tip + PAD_CENTRE_X, y_tip + sign * (PAD_SIZE[1] / 2 - PAD_FACE_Y), 0.0), PAD_SIZE)
+        )
+        out.append(
+            (
+                (BAR_X0 + bar / 2, y_tip + sign * (PAD_SIZE[1] + 0.004 - PAD_FACE_Y), 0.0),
+                (bar, *BAR_SIZE_YZ),
+            )
+        )
+    return out
+
+
+def tip_slide(half_opening: float) -> float:
+    """The model's fingertip slide joint value (m) for pads ``half_opening`` out: 0 when closed."""
+    return tip_x(half_opening) - tip_x(0.0)
 
 
 #: Upper-arm COM and inertia, which pr2_description gives per side (``ual_*`` left, ``uar_*`` right,
@@ -365,37 +456,67 @@ def _gripper(m: UrdfBuilder, s: str) -> None:
         f"{s}_gripper_tcp",
         source="tool-centre-point frame: x = approach, y = finger opening direction",
     )
-    pad_cx = TCP_X - FINGER_X
-    bar_len = pad_cx - PAD_SIZE[0] / 2 - 0.02
+    # Each finger: a lateral prismatic joint (the commanded half opening, N of grip force) carrying the
+    # proximal bar, then a fingertip slide along the approach that the controller keeps at
+    # tip_slide(half opening) (FingertipLinkage in robots/config.py): the pad face then is where the
+    # real four-bar puts it at every opening, parallel to the palm, as the real mimic chain keeps it.
+    bar_len = _bar_length()
     for finger, sign in (("l", 1.0), ("r", -1.0)):
         m.joint(
             f"{s}_gripper_{finger}_finger_joint",
             "prismatic",
             f"{s}_gripper_palm_link",
             f"{s}_gripper_{finger}_finger_link",
-            xyz=(FINGER_X, 0.0, 0.0),
+            xyz=(0.0, sign * (PAD_GAP + PAD_FACE_Y), 0.0),
             axis=(0.0, sign, 0.0),
             lower=0.0,
             upper=FINGER_TRAVEL,
             effort=100.0,
             velocity=0.2,
             damping=0.0,
-            source=f"finger base x {FINGER_X} (l_gripper_l_finger_joint origin, gripper_v0/gripper.urdf.xacro); "
-            "prismatic stand-in for the linkage: travel 0..0.044 m per finger = 0..90 mm opening with 1 mm pad gaps; "
-            "velocity 0.2 m/s as l_gripper_joint; effort 100 N (assumed, above the 20 N default grip)",
+            source="lateral stand-in for the four-bar's proximal joint (l_gripper_l_finger_joint, "
+            "gripper_v0/gripper.urdf.xacro): the child frame is level with the real fingertip frame; travel "
+            "0..0.044 m per finger = 0..90 mm opening with 1 mm pad gaps; velocity 0.2 m/s as l_gripper_joint; "
+            "effort 100 N (assumed, above the 20 N default grip)",
         )
-        pad_y = sign * (PAD_GAP + PAD_SIZE[1] / 2)
-        bar_y = sign * (PAD_GAP + PAD_SIZE[1] + 0.004)
         m.link(
             f"{s}_gripper_{finger}_finger_link",
             [
-                Geom("box", PAD_SIZE, (pad_cx, pad_y, 0.0)),
-                Geom("box", (bar_len, 0.008, 0.02), (0.02 + bar_len / 2, bar_y, 0.0)),
+                Geom(
+                    "box",
+                    (bar_len, *BAR_SIZE_YZ),
+                    (BAR_X0 + bar_len / 2, sign * (PAD_SIZE[1] + 0.004 - PAD_FACE_Y), 0.0),
+                )
             ],
-            0.17126 + 0.04419,
-            source="mass 0.17126 + 0.04419 kg = finger + fingertip links (gripper_v0/gripper.urdf.xacro); "
-            "COM and inertia from the shapes (the published ones are of the linkage's revolute links); "
-            "pad centred on the tool frame, 35 x 22 mm face",
+            FINGER_MASS[finger],
+            source=f"mass {FINGER_MASS[finger]} kg of {s}_gripper_{finger}_finger_link (gripper_v0/gripper.urdf.xacro); "
+            "COM and inertia from the bar (the published ones are of the revolute proximal link)",
+        )
+        m.joint(
+            f"{s}_gripper_{finger}_finger_tip_joint",
+            "prismatic",
+            f"{s}_gripper_{finger}_finger_link",
+            f"{s}_gripper_{finger}_finger_tip_link",
+            xyz=(tip_x(0.0), 0.0, 0.0),
+            axis=(1.0, 0.0, 0.0),
+            lower=round(tip_slide(FINGER_TRAVEL + PAD_GAP), 9),
+            upper=0.0,
+            effort=1000.0,
+            velocity=0.2,
+            damping=0.0,
+            source="fingertip slide along the approach, kept at the four-bar's arc: tip x = 0.07691 + R cos(theta + phi), "
+            "R = |(0.09137, 0.00495)| (finger and fingertip joint origins, gripper_v0/gripper.urdf.xacro); "
+            "effort 1000 as finger_joint_effort_limit (the linkage is rigid)",
+        )
+        m.link(
+            f"{s}_gripper_{finger}_finger_tip_link",
+            [Geom("box", PAD_SIZE, (PAD_CENTRE_X, sign * (PAD_SIZE[1] / 2 - PAD_FACE_Y), 0.0))],
+            TIP_MASS,
+            com=TIP_COM[finger],
+            inertia=TIP_INERTIA[finger],
+            source=f"{s}_gripper_{finger}_finger_tip_link: mass, COM and inertia as published (gripper.urdf.xacro); "
+            "pad box = the 36 x 23 mm face of meshes/gripper_v0/finger_tip_pad2_l.stl, inner face 0.01495 m "
+            "inside the fingertip frame",
         )
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from ...geometry import Pose
-from ...robots.descriptions.pr2 import FINGER_TRAVEL, FINGER_X, PAD_GAP, PAD_SIZE, TCP_X
+from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, TCP_X, finger_boxes
 from .config import ExecutionConfig
 
 __all__ = [
@@ -67,37 +67,15 @@ class RigFailure(Exception):
 def gripper_boxes(opening: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """The gripper's collision boxes (centre, half extents) in the **tool** frame at ``opening`` (m).
 
-    Mirrors :func:`benchharness.robots.descriptions.pr2._gripper` (same
-    constants): palm, two pads, two finger bars. Used to keep every hand pose
-    clear of the table before it is commanded.
+    The palm and :func:`benchharness.robots.descriptions.pr2.finger_boxes` (the
+    pads and finger bars where the four-bar puts them), moved from the palm
+    frame to the tool frame. Used to keep every hand pose clear of the table
+    before it is commanded.
     """
-    q = max(0.0, min(FINGER_TRAVEL, opening / 2.0 - PAD_GAP))
-    palm_x = -TCP_X
-    out = [(np.array([palm_x + 0.08, 0.0, 0.0]), np.array([0.03, 0.035, 0.025]))]
-    pad_cx = TCP_X - FINGER_X
-    bar_len = pad_cx - PAD_SIZE[0] / 2 - 0.02
-    for sign in (1.0, -1.0):
-        y0 = sign * q
-        out.append(
-            (
-                np.array(
-                    [palm_x + FINGER_X + pad_cx, y0 + sign * (PAD_GAP + PAD_SIZE[1] / 2), 0.0]
-                ),
-                np.array(PAD_SIZE) / 2,
-            )
-        )
-        out.append(
-            (
-                np.array(
-                    [
-                        palm_x + FINGER_X + 0.02 + bar_len / 2,
-                        y0 + sign * (PAD_GAP + PAD_SIZE[1] + 0.004),
-                        0.0,
-                    ]
-                ),
-                np.array([bar_len / 2, 0.004, 0.01]),
-            )
-        )
+    opening = max(2 * PAD_GAP, min(2 * (FINGER_TRAVEL + PAD_GAP), opening))
+    out = [(np.array([0.08 - TCP_X, 0.0, 0.0]), np.array([0.03, 0.035, 0.025]))]
+    for c, size in finger_boxes(opening):
+        out.append((np.array(c) - [TCP_X, 0.0, 0.0], np.array(size) / 2))
     return out
 
 

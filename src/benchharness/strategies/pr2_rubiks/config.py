@@ -10,9 +10,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ...cube_physics.config import CubeConfig
+from ...robots.descriptions.pr2 import PAD_SIZE, pad_setback
 from ..error_sources import ErrorConfig
 
-__all__ = ["ErrorConfig", "PR2RubiksConfig"]
+__all__ = ["ErrorConfig", "PR2RubiksConfig", "grip_offset"]
+
+
+def grip_offset(inner_end: float, edge: float = CubeConfig().edge) -> float:
+    """Tool-frame distance from the cube centre that puts the pads' inner end ``inner_end`` from it.
+
+    The pads are ``PAD_SIZE[0]`` long and, on the PR2's four-bar fingers, their centre sits
+    ``pad_setback(edge)`` behind the tool frame when they close on the cube (4.7 mm at 57 mm),
+    so the tool frame goes that much nearer the centre than the pads' middle.
+    """
+    return inner_end + PAD_SIZE[0] / 2 - pad_setback(edge)
 
 
 @dataclass(frozen=True)
@@ -35,14 +47,14 @@ class PR2RubiksConfig:
     #: directly below it >= 0.42 rad; at the former (0.60, 0, 0.80) the turn about z had no smooth
     #: solution inside them (docs/strategies.md, "Twisting pose").
     twist_position: tuple[float, float, float] = (0.60, 0.0, 0.60)
-    #: distance from the cube centre to the tool frame along the work axis for a grip
-    #: `depth` slabs deep. The 35 mm pad is centred on the tool frame, so its inner end sits
-    #: `offset - 17.5 mm` from the centre. Holder 17.5 mm -> inner end at 0: on the middle slab
-    #: (-9.5..9.5 mm) with half a cubie (9.5 mm) of margin either way, the paper's tolerance.
-    #: Rotator 34 mm -> inner end at 16.5 mm: 7 mm clear of the middle slab, 12 mm of the outer
-    #: slab under the pad.
-    rotator_offset: float = 0.034
-    holder_offset: float = 0.0175
+    #: distance from the cube centre to the tool frame along the work axis for a grip `depth` slabs
+    #: deep, derived from where the pads' inner end must sit (:func:`grip_offset`: the 36 mm pad's
+    #: centre is 4.7 mm behind the tool frame at the 57 mm grip). Holder: inner end at 0 -> 13.3 mm;
+    #: the pad covers the middle slab (-9.5..9.5 mm) up to its centre line, half a cubie (9.5 mm) of
+    #: margin either way, the paper's tolerance. Rotator: inner end at 16.5 mm -> 29.8 mm; 7 mm clear
+    #: of the middle slab, 12 mm of the outer slab under the pad.
+    rotator_offset: float = grip_offset(0.0165)
+    holder_offset: float = grip_offset(0.0)
     #: stand-off of the pre-grasp pose along the approach (m).
     pregrasp_distance: float = 0.07
     #: stand-off the arm swings round at before a pre-grasp (m): the fingers open to 90 mm and a
