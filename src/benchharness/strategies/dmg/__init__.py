@@ -11,7 +11,7 @@ patches, planned as a shortest path. See ``docs/dmg.md``.
 Modules: :mod:`.config` (parameters), :mod:`.patches` (surface
 discretisation), :mod:`.graph` (construction, "DMG time"), :mod:`.planner`
 (queries, "Plan time"), :mod:`.placement` (published data on our meshes),
-:mod:`.runner` (the strategy object, results files), :mod:`.execution`
+:mod:`.strategy` (the strategy object, results files), :mod:`.execution`
 (executing plans on a simulator with the ``pr2-gripper``: the strategy's
 ``run_trial``), :mod:`.regions` (the Level II task set and the
 contact-region errors of executed trials). Importing this package is cheap:
@@ -26,8 +26,8 @@ __all__ = ["REGISTRATIONS", "make_planner"]
 
 
 def make_planner(**kwargs):
-    """Strategy factory: a :class:`~.runner.DMGPlanner` (keyword arguments pass through)."""
-    from .runner import DMGPlanner
+    """Strategy factory: a :class:`~.strategy.DMGPlanner` (keyword arguments pass through)."""
+    from .strategy import DMGPlanner
 
     return DMGPlanner(**kwargs)
 

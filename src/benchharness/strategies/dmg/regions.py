@@ -5,7 +5,7 @@
 contact region ``C_d`` only. We derive it from the four published DMG tasks:
 same initial grasp (pose and contacts), no desired hand pose (empty
 columns, level 2), and ``C_d`` = the union of two geodesic discs of radius
-``region_radius`` (:data:`~.runner.DESIRED_REGION_RADIUS`, 5 mm: about half a
+``region_radius`` (:data:`~.strategy.DESIRED_REGION_RADIUS`, 5 mm: about half a
 finger pad) on our mesh, centred where the published desired contacts fall
 on our surface along the line through them (the fingers' closing line). The
 disc centres are kept as ``desired_contact1/2`` so the file stays readable
@@ -15,8 +15,8 @@ without meshes; the region is rebuilt on the mesh by :func:`desired_region`.
 (:func:`benchharness.metrics.contact.contact_region_error`) between ``C_d``
 and the two finger pads as they touched the object at the end of the trial
 (5 mm geodesic discs around the measured contact points,
-:data:`~.runner.FINGER_PAD_RADIUS`), on our mesh placed in the task frame --
-the same construction :func:`.runner.results_for_grasps` uses for planned
+:data:`~.strategy.FINGER_PAD_RADIUS`), on our mesh placed in the task frame --
+the same construction :func:`.strategy.results_for_grasps` uses for planned
 grasps, so planned and executed figures compare. The runner scores poses
 only; :func:`score_store` adds G_euc / G_geo / G_min to stored trials.
 """
@@ -45,7 +45,7 @@ def derive_region_tasks(level3_path: str | Path | None = None):
     from ...inhand.fileformat import read_tasks
     from ...inhand.records import TaskSet
     from ...paths import tasks_dir
-    from .runner import DESIRED_REGION_RADIUS
+    from .strategy import DESIRED_REGION_RADIUS
 
     src = read_tasks(
         Path(level3_path) if level3_path else tasks_dir() / "inhand" / "level3_dmg_tasks.csv"
@@ -76,7 +76,7 @@ def write_region_tasks(path: str | Path) -> Path:
 
 
 def _mesh_in_task_frame(obj: str, planner=None):
-    from .runner import DMGPlanner
+    from .strategy import DMGPlanner
 
     planner = planner or DMGPlanner()
     return planner.placement(obj).mesh_in_published(planner.mesh_for(obj))
@@ -110,7 +110,7 @@ def contact_errors(
     """G_euc, G_geo, G_min (m) of one trial, all in the task frame (see the module docstring)."""
     from ...metrics.contact import contact_region_error
     from ...objects import contact_region
-    from .runner import DESIRED_REGION_RADIUS, FINGER_PAD_RADIUS
+    from .strategy import DESIRED_REGION_RADIUS, FINGER_PAD_RADIUS
 
     mesh = _mesh_in_task_frame(obj, planner)
     region = desired_region(
