@@ -13,8 +13,9 @@ discretisation), :mod:`.graph` (construction, "DMG time"), :mod:`.planner`
 (queries, "Plan time"), :mod:`.placement` (published data on our meshes),
 :mod:`.strategy` (the strategy object, results files), :mod:`.execution`
 (executing plans on a simulator with the ``pr2-gripper``: the strategy's
-``run_trial``), :mod:`.regions` (the Level II task set and the
-contact-region errors of executed trials). Importing this package is cheap:
+``run_trial``). The Level II task set and the contact-region errors of
+stored trials are scoring, in :mod:`benchharness.runner.contact_regions`.
+Importing this package is cheap:
 trimesh/networkx load inside the factory's products.
 """
 
