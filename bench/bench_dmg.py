@@ -38,7 +38,7 @@ PUBLISHED = {
 def main(argv=None) -> int:
     from benchharness.inhand.fileformat import read_results, read_tasks, write_results
     from benchharness.inhand.scoring import score_results
-    from benchharness.strategies.dmg.runner import (
+    from benchharness.strategies.dmg.strategy import (
         DESIRED_REGION_RADIUS,
         FINGER_PAD_RADIUS,
         DMGPlanner,

@@ -3,11 +3,13 @@
 * the metric module is pure: importing it pulls in no simulator, no torch and
   no plotting library, so real-robot users can score logs anywhere;
 * importing the CLI imports no simulator (subcommands load lazily);
+* the CLI imports no strategy (scoring of stored trials is the runner's);
 * only ``benchharness/backends`` imports pybullet or sapien.
 """
 
 from __future__ import annotations
 
+import ast
 import re
 import subprocess
 import sys
@@ -42,6 +44,64 @@ def test_only_backends_import_engines():
         if "backends" not in p.relative_to(SRC).parts and pattern.search(p.read_text())
     ]
     assert offenders == []
+
+
+def _imported_modules(path: Path, package: str) -> set[str]:
+    """Absolute names of every module ``path`` imports, at any depth (lazy imports included).
+
+    Relative imports are resolved against ``package`` (the module's own
+    package), so ``from ..strategies.dmg import x`` in ``benchharness.cli.run``
+    counts as ``benchharness.strategies.dmg`` and, for ``from pkg import name``,
+    also ``pkg.name`` (which may be a submodule).
+    """
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[: len(parts) - node.level + 1])
+                mod = f"{base}.{node.module}" if node.module else base
+            else:
+                mod = node.module or ""
+            out.add(mod)
+            out.update(f"{mod}.{a.name}" for a in node.names)
+    return out
+
+
+def test_imported_modules_resolves_relative_and_lazy_imports(tmp_path):
+    """The scanner below must see a lazy relative import of a strategy, or the CLI test proves nothing."""
+    src = tmp_path / "m.py"
+    src.write_text("def f():\n    from ..strategies.dmg import regions\n    import os.path\n")
+    found = _imported_modules(src, "benchharness.cli")
+    assert {
+        "benchharness.strategies.dmg",
+        "benchharness.strategies.dmg.regions",
+        "os.path",
+    } <= found
+
+
+def test_cli_imports_no_strategy():
+    """No CLI module imports ``benchharness.strategies`` (docs/architecture.md, "Rules").
+
+    The CLI is the top layer and reaches strategies only through the plugin
+    manager; what it needs of stored trials (contact-region errors) is
+    scoring, which lives in ``runner/``. Scans every import in ``cli/*.py``,
+    including those inside functions, which a sys.modules check at start-up
+    would miss.
+    """
+    cli_files = sorted((SRC / "cli").glob("*.py"))
+    assert len(cli_files) >= 8  # main, run, inhand, ...: the scan sees the real package
+    offenders = {
+        p.name: sorted(
+            m
+            for m in _imported_modules(p, "benchharness.cli")
+            if m == "benchharness.strategies" or m.startswith("benchharness.strategies.")
+        )
+        for p in cli_files
+    }
+    assert {k: v for k, v in offenders.items() if v} == {}
 
 
 DOC = SRC.parents[1] / "docs" / "architecture.md"

@@ -162,7 +162,7 @@ def test_published_gelatin_task_reaches_the_desired_contacts(gelatin):
 def test_scored_results_go_through_the_metric_module(gelatin, tmp_path):
     from benchharness.inhand.fileformat import read_results
     from benchharness.inhand.scoring import score_results
-    from benchharness.strategies.dmg.runner import write_dmg_results
+    from benchharness.strategies.dmg.strategy import write_dmg_results
 
     tasks, i, planner, tp = gelatin
     path = write_dmg_results(tasks, [tp], planner, tmp_path / "results.csv")
@@ -177,7 +177,7 @@ def test_scored_results_go_through_the_metric_module(gelatin, tmp_path):
 
 def test_registration_is_cheap_and_builds_a_planner():
     from benchharness.strategies.dmg import REGISTRATIONS
-    from benchharness.strategies.dmg.runner import DMGPlanner
+    from benchharness.strategies.dmg.strategy import DMGPlanner
 
     (reg,) = REGISTRATIONS
     assert reg.name == "dmg"

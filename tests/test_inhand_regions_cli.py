@@ -4,16 +4,14 @@
 file named ``--help``; with no argument it rewrote the tracked
 tasks/inhand/level2_dmg_regions.csv; a missing store became an empty file.
 Now ``inhand regions STORE`` only reads, and ``inhand region-tasks --out``
-writes only where asked.
+writes only where asked (the module itself is now
+``benchharness.runner.contact_regions``, with no command of its own).
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 from click.testing import CliRunner
@@ -73,20 +71,3 @@ def test_regions_reads_a_store_without_modifying_it(tmp_path):
     r = _invoke("regions", other)
     assert r.exit_code == 2 and "not a benchharness results store" in r.stderr
     assert other.read_text() == "not a database"
-
-
-def test_the_old_module_entry_point_writes_nothing(tmp_path):
-    before = _digest(TRACKED)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO / "src"), str(REPO / "plugins")])}
-    for args in (["--help"], []):
-        p = subprocess.run(
-            [sys.executable, "-m", "benchharness.strategies.dmg.regions", *args],
-            cwd=tmp_path,
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
-        assert p.returncode != 0 and "benchharness inhand regions" in p.stderr
-    assert list(tmp_path.iterdir()) == []
-    assert _digest(TRACKED) == before

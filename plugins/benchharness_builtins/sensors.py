@@ -44,7 +44,7 @@ def _pretouch(*, backend, body, link=None, emitters, config=None, ignore_bodies=
 
 def _cube_kf(*, config=None, tof=None, initial=None, **kwargs):
     from benchharness.sensors.config import CubeFilterConfig
-    from benchharness.sensors.estimator import CubePoseFilter
+    from benchharness.sensors.cube_filter import CubePoseFilter
 
     cfg = _config(CubeFilterConfig, config, kwargs)
     if kwargs:

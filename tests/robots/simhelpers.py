@@ -6,7 +6,7 @@ import numpy as np
 import torch
 
 from benchharness.geometry import Pose
-from benchharness.kinematics import KinematicTree, pose_error
+from benchharness.robots.kinematics import KinematicTree, pose_error
 
 #: Tolerances stated for tracked motions (docs/robots.md repeats them).
 TRACK_MAX_ERROR = 0.05  # rad, max |q_ref - q| during a move at half the velocity limits

@@ -23,7 +23,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from benchharness.geometry import Pose
-from benchharness.kinematics import KinematicTree, pose_error
+from benchharness.robots.kinematics import KinematicTree, pose_error
 
 PI = np.pi
 TOL_M, TOL_RAD = 1e-3, np.radians(0.5)

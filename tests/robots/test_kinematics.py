@@ -18,7 +18,7 @@ import pytest
 import torch
 import yourdfpy
 
-from benchharness.kinematics import pose_error
+from benchharness.robots.kinematics import pose_error
 
 CHAINS = [
     ("pr2", "left_arm"),
@@ -224,7 +224,7 @@ def test_rotation_error_matches_scipy():
     """The seeded IK's rotation error (shortest rotation vector) vs scipy, incl. angles near 0 and pi."""
     from scipy.spatial.transform import Rotation
 
-    from benchharness.kinematics import _rotvec_between
+    from benchharness.robots.kinematics import _rotvec_between
 
     cur = Rotation.random(300, random_state=2)
     rng = np.random.default_rng(0)
@@ -257,7 +257,7 @@ def test_numpy_dls_matches_pytorch_kinematics_solver(robots, robot, chain):
     """
     import torch as _t
 
-    from benchharness.kinematics import DTYPE
+    from benchharness.robots.kinematics import DTYPE
 
     arm = robots[robot].arm(chain)
     ch = arm.chain

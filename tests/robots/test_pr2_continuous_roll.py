@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchharness.kinematics import pose_error
+from benchharness.robots.kinematics import pose_error
 
 
 def _left_arm(robots):

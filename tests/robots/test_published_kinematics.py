@@ -34,8 +34,8 @@ import torch
 from scipy.spatial.transform import Rotation
 
 from benchharness.geometry import Pose
-from benchharness.kinematics import KinematicTree, pose_error
 from benchharness.paths import robots_dir
+from benchharness.robots.kinematics import KinematicTree, pose_error
 
 POS_TOL = 1e-3  # m
 ROT_TOL = math.radians(0.5)

@@ -49,7 +49,7 @@ def _planner(execution=SHORT):
 
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_short_dmg_task_executes_and_scores(backend):
-    from benchharness.strategies.dmg.regions import contact_errors
+    from benchharness.runner.contact_regions import contact_errors
 
     item = _short_item()
     ctx, b = make_context(backend, item)
@@ -94,7 +94,7 @@ def test_plan_to_region_ends_in_the_region():
 
 def test_region_task_file_matches_derivation(tmp_path):
     from benchharness.paths import tasks_dir
-    from benchharness.strategies.dmg.regions import write_region_tasks
+    from benchharness.runner.contact_regions import write_region_tasks
 
     fresh = write_region_tasks(tmp_path / "r.csv")
     assert fresh.read_text() == (tasks_dir() / "inhand" / "level2_dmg_regions.csv").read_text()

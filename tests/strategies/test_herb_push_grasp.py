@@ -128,7 +128,7 @@ def test_push_grasp_removes_belief_error_along_the_approach(make_backend, make_r
             believed_error > BELIEF_ERROR - 0.003
         )  # the hand did stop ~8 mm away from the believed grasp
         fixed, shift = reanchor_along_approach(belief, res.commanded, design)
-        print(  # the figures of docs/herb_push_grasp.md (pytest -s)
+        print(  # the figures of docs/benchmarks/herb_push_grasp.md (pytest -s)
             f"{backend} belief {sign * BELIEF_ERROR * 1e3:+.0f} mm: travel {res.travel * 1e3:.1f} mm, "
             f"grasp depth error {grasp_error * 1e3:.2f} mm, belief after "
             f"{abs(fixed.p[2] - true.p[2]) * 1e3:.2f} mm, stop force {res.force:.1f} N"
@@ -263,7 +263,7 @@ def test_rubiks_1_5_through_the_cli_is_scored(tmp_path, backend):
     """`benchharness run --task Rubiks-1-5 --robot herb --strategy push-grasp`: runs, is stored and scored.
 
     On both engines the whole trial succeeds on the corrected HERB (issue 11): all 5 moves as intended,
-    the final state checked by the protocol validator (docs/herb_push_grasp.md, measured outcomes).
+    the final state checked by the protocol validator (docs/benchmarks/herb_push_grasp.md).
     """
     import json
 

@@ -1,6 +1,7 @@
 """Engine-independent helpers shared by the built-in backends.
 
-* mass properties of primitive and convex shapes (uniform density),
+* mass properties of collision shapes (uniform density; the formulas are
+  :mod:`benchharness.inertia`'s),
 * a small URDF reader (joints, limits, links) so that both engines report the
   same joint order, limits and collision filtering,
 * writing a collision-only copy of a URDF (SAPIEN's loader needs a render
@@ -23,38 +24,41 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..geometry import Pose
+from ..inertia import (
+    box_inertia,
+    box_volume,
+    convex_hull_properties,
+    cylinder_inertia,
+    cylinder_volume,
+    sphere_inertia,
+    sphere_volume,
+)
 from .interface import BackendError, Box, Cylinder, JointInfo, MeshShape, Shape, Sphere
 
 MOVABLE = ("revolute", "prismatic", "continuous")
 
 
 # -- mass properties ----------------------------------------------------------
-def _shape_volume_com_inertia(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
-    """Volume, centre (shape frame) and inertia tensor per unit density about that centre."""
-    if isinstance(shape, Box):
-        a, b, c = (2.0 * np.asarray(shape.half_extents, dtype=float)).tolist()
-        v = a * b * c
-        i = v / 12.0 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
-        return v, np.zeros(3), i
-    if isinstance(shape, Sphere):
-        r = float(shape.radius)
-        v = 4.0 / 3.0 * math.pi * r**3
-        return v, np.zeros(3), np.eye(3) * 0.4 * v * r * r
-    if isinstance(shape, Cylinder):
-        r, h = float(shape.radius), 2.0 * float(shape.half_length)
-        v = math.pi * r * r * h
-        ixx = v * (3 * r * r + h * h) / 12.0
-        return v, np.zeros(3), np.diag([ixx, ixx, 0.5 * v * r * r])
-    if isinstance(shape, MeshShape):
-        import trimesh
+def shape_volume_com_inertia(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
+    """Volume, centre (shape frame) and inertia tensor per unit density about that centre.
 
-        hull = trimesh.convex.convex_hull(np.asarray(shape.vertices, dtype=float))
-        v = float(hull.volume)
-        return (
-            v,
-            np.asarray(hull.center_mass, dtype=float),
-            np.asarray(hull.moment_inertia, dtype=float),
-        )
+    The one mapping from a collision :class:`Shape` to the primitive formulas
+    of :mod:`benchharness.inertia`; the object models use it too
+    (:func:`benchharness.objects.mass.mass_properties`).
+    """
+    if isinstance(shape, Box):
+        size = (2.0 * np.asarray(shape.half_extents, dtype=float)).tolist()
+        v = box_volume(size)
+        return v, np.zeros(3), np.diag(box_inertia(v, size))
+    if isinstance(shape, Sphere):
+        v = sphere_volume(shape.radius)
+        return v, np.zeros(3), np.diag(sphere_inertia(v, shape.radius))
+    if isinstance(shape, Cylinder):
+        length = 2.0 * float(shape.half_length)
+        v = cylinder_volume(shape.radius, length)
+        return v, np.zeros(3), np.diag(cylinder_inertia(v, shape.radius, length))
+    if isinstance(shape, MeshShape):
+        return convex_hull_properties(shape.vertices)
     raise BackendError(f"unknown shape type {type(shape).__name__}")
 
 
@@ -84,7 +88,7 @@ def mass_properties(
         raise BackendError("a body needs at least one shape")
     vols, centres, tensors = [], [], []
     for s in shapes:
-        v, c, i = _shape_volume_com_inertia(s)
+        v, c, i = shape_volume_com_inertia(s)
         r = s.pose.rotation.as_matrix()
         vols.append(v)
         centres.append(s.pose.apply(c))

@@ -336,7 +336,7 @@ def regions_cmd(store: Path, as_json: bool) -> None:
     Example:
       benchharness inhand regions benchharness-results.sqlite
     """
-    from ..strategies.dmg.regions import score_store
+    from ..runner.contact_regions import score_store
 
     if not store.is_file():
         fail(f"{store}: no such results store")
@@ -391,7 +391,7 @@ def region_tasks_cmd(out: Path, as_json: bool) -> None:
     Example:
       benchharness inhand region-tasks --out /tmp/level2_dmg_regions.csv
     """
-    from ..strategies.dmg.regions import write_region_tasks
+    from ..runner.contact_regions import write_region_tasks
 
     if not out.parent.is_dir():
         fail(f"--out {out}: folder {out.parent} does not exist")

@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any
 
 import click
-import numpy as np
 
 from .common import EXIT_NEGATIVE, emit_json, fail, json_option, print_table
 from .common import console as _rich_console
@@ -584,6 +583,7 @@ def table(
       benchharness table --benchmark rubiks --run-tiers
       benchharness table --benchmark inhand --plot figure7.png
     """
+    from ..runner.contact_regions import stored_contact_scorer
     from ..runner.reports import (
         format_cell,
         inhand_box_plot,
@@ -641,7 +641,10 @@ def table(
                 if "," in c.code_version:
                     console.print(f"{_esc(c.label)}: runs from code versions {c.code_version}")
     if "inhand" in wanted:
-        t2, t3 = inhand_table2(trials), inhand_table3(trials, contact_scorer=_contact_scorer())
+        t2, t3 = (
+            inhand_table2(trials),
+            inhand_table3(trials, contact_scorer=stored_contact_scorer()),
+        )
         if as_json:
             out["inhand"] = {"table2": t2, "table3": t3}
         else:
@@ -703,42 +706,6 @@ def table(
             console.print(f"Box plot (Figure 7 layout) written to {plot_path}")
     if as_json:
         emit_json(out)
-
-
-def _contact_scorer():
-    """G_euc / G_geo / G_min of a stored trial with reached contacts, on our mesh in the task frame.
-
-    The mesh placement in the published task frame is the DMG package's
-    (``strategies.dmg.regions``); desired contacts come from the task-set
-    plugin named by the trial's run. Trials without contacts score None.
-    """
-    try:
-        from ..strategies.dmg.regions import contact_errors
-    except ImportError:  # trimesh/potpourri3d absent: the table prints without G
-        return None
-    from ..plugin import get_manager
-
-    desired: dict[str, dict[str, Any]] = {}
-
-    def score(trial) -> dict[str, float] | None:
-        o = trial.outcome
-        rc = o.get("reached_contacts")
-        if not rc:
-            return None
-        if trial.task not in desired:
-            try:
-                ts = get_manager().create("task", trial.task)
-                desired[trial.task] = {
-                    str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)
-                }
-            except Exception:  # noqa: BLE001 - not an in-hand task set with contacts
-                desired[trial.task] = {}
-        want = desired[trial.task].get(o.get("task_id"))
-        if want is None or not np.all(np.isfinite(np.asarray(want, float))):
-            return None
-        return contact_errors(o["object"], want, rc)
-
-    return score
 
 
 # -- compare -----------------------------------------------------------------------------------

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..cube.facelets import FACE_NORMALS, FACELET_NAMES, FACELET_POSITIONS
+from ..inertia import box_inertia
 from .config import CubeConfig
 
 __all__ = [
@@ -43,7 +44,6 @@ __all__ = [
     "SlabGeometry",
     "articulated_urdf",
     "axis_index",
-    "box_inertia",
     "rigid_half_extents",
     "rigid_inertia",
     "slab_geometry",
@@ -95,12 +95,6 @@ def axis_index(axis: str) -> int:
         return AXES.index(axis)
     except ValueError:
         raise ValueError(f"unknown twist axis {axis!r}; axes are x, y, z (body frame)") from None
-
-
-def box_inertia(mass: float, size: np.ndarray) -> np.ndarray:
-    """Principal moments (kg·m²) of a uniform box with full side lengths ``size``."""
-    a, b, c = np.asarray(size, dtype=float)
-    return mass / 12.0 * np.array([b * b + c * c, a * a + c * c, a * a + b * b])
 
 
 def rigid_half_extents(config: CubeConfig) -> tuple[float, float, float]:

@@ -44,7 +44,7 @@ import numpy as np
 
 from .boxunion import AABox
 from .spec import BoxGeometry, Citation, ObjectSpec, SweepGeometry, YcbScan
-from .sweep import Segment, SweepProfile, _dense_samples
+from .swept import Segment, SweepProfile, _dense_samples
 
 __all__ = ["CATALOG", "CALLI_2015", "DRAKE_YCB", "DUPLO_SCALE", "ESTIMATE"]
 

@@ -4,8 +4,11 @@ A backend spreads a body's mass uniformly over its shapes' volume unless it
 is given a centre of mass and inertia. The two engines disagree on how they
 do that for overlapping or mesh shapes, so we compute the properties once,
 here, and pass them explicitly: uniform density ``mass / total volume``,
-closed forms for boxes, spheres and cylinders, trimesh's exact polyhedral
-integrals for convex mesh pieces.
+each shape's own properties from the one set of primitive formulas
+(:mod:`benchharness.inertia`, through the backends' shape mapping
+:func:`~benchharness.backends._urdf.shape_volume_com_inertia`): closed forms
+for boxes, spheres and cylinders, trimesh's exact polyhedral integrals for
+convex mesh pieces.
 
 Shapes are assumed not to overlap (our collision models are built that way:
 ring-plane hull pieces, studs *on* the brick, wings *beside* the fuselage);
@@ -20,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from ..backends.interface import Box, Cylinder, MeshShape, Shape, Sphere
+from ..backends._urdf import shape_volume_com_inertia
+from ..backends.interface import Shape
 
 __all__ = ["MassProperties", "shape_volume", "mass_properties"]
 
@@ -55,31 +59,8 @@ class MassProperties:
         return float(np.abs(off).max() / np.abs(np.diag(self.inertia)).max())
 
 
-def _local(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
-    """Volume, centroid and unit-density inertia about the centroid, in the shape frame."""
-    if isinstance(shape, Box):
-        hx, hy, hz = shape.half_extents
-        v = 8.0 * hx * hy * hz
-        inertia = v / 3.0 * np.diag([hy**2 + hz**2, hx**2 + hz**2, hx**2 + hy**2])
-        return v, np.zeros(3), inertia
-    if isinstance(shape, Sphere):
-        r = shape.radius
-        v = 4.0 / 3.0 * np.pi * r**3
-        return v, np.zeros(3), np.eye(3) * 0.4 * v * r**2
-    if isinstance(shape, Cylinder):
-        r, hl = shape.radius, shape.half_length
-        v = np.pi * r**2 * 2 * hl
-        ixx = v * (3 * r**2 + (2 * hl) ** 2) / 12.0
-        return v, np.zeros(3), np.diag([ixx, ixx, v * r**2 / 2.0])
-    if isinstance(shape, MeshShape):
-        hull = trimesh.convex.convex_hull(np.asarray(shape.vertices, float))
-        hull.density = 1.0
-        return float(hull.volume), np.asarray(hull.center_mass), np.asarray(hull.moment_inertia)
-    raise TypeError(f"not a collision shape: {type(shape).__name__}")
-
-
 def shape_volume(shape: Shape) -> float:
-    return _local(shape)[0]
+    return shape_volume_com_inertia(shape)[0]
 
 
 def mass_properties(shapes: Sequence[Shape], mass: float) -> MassProperties:
@@ -88,7 +69,7 @@ def mass_properties(shapes: Sequence[Shape], mass: float) -> MassProperties:
         raise ValueError("a collision model needs at least one shape")
     parts = []
     for s in shapes:
-        v, c, i_unit = _local(s)
+        v, c, i_unit = shape_volume_com_inertia(s)
         rot = s.pose.rotation.as_matrix()
         parts.append((v, s.pose.apply(c), rot @ i_unit @ rot.T))
     vol = sum(p[0] for p in parts)

@@ -28,7 +28,7 @@ from .boxunion import mesh_box_union
 from .catalog import CATALOG
 from .mass import MassProperties, mass_properties, solid_mass_properties
 from .spec import BoxGeometry, ObjectSpec, SweepGeometry
-from .sweep import mesh_sweep, pieces_as_meshes
+from .swept import mesh_sweep, pieces_as_meshes
 
 __all__ = [
     "DEFAULT_RESOLUTION",

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from .boxunion import AABox
-from .sweep import SweepProfile
+from .swept import SweepProfile
 
 __all__ = [
     "Citation",
@@ -35,7 +35,7 @@ class Citation:
 
 @dataclass(frozen=True)
 class SweepGeometry:
-    """An elliptical-section sweep (see :mod:`.sweep`).
+    """An elliptical-section sweep (see :mod:`.swept`).
 
     ``axis="z"`` turns the sweep axis from x to z (bodies of revolution stand
     on their axis, like the real can). ``collision`` picks the collision

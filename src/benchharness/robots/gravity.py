@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..kinematics import KinematicTree
+from .kinematics import KinematicTree
 
 __all__ = ["GravityModel"]
 

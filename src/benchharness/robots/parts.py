@@ -18,8 +18,8 @@ import torch
 
 from ..backends.interface import BodyId
 from ..geometry import Pose
-from ..kinematics import IKConfig, IKResult, KinematicChain, pose_error
 from .config import ArmConfig, GripperConfig
+from .kinematics import IKConfig, IKResult, KinematicChain, pose_error
 from .trajectory import QuinticTrajectory
 
 if TYPE_CHECKING:
@@ -162,7 +162,7 @@ class RobotArm:
         Each solution is then unwrapped by the multiple of 2*pi that brings it
         nearest the seed.
         """
-        from ..kinematics import IKResult
+        from .kinematics import IKResult
 
         t = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
         b, dof = t.shape[0], len(self.joints)

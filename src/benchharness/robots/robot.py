@@ -16,10 +16,10 @@ import numpy as np
 
 from ..backends.interface import Backend, BodyId
 from ..geometry import Pose
-from ..kinematics import IKConfig
 from .config import RobotConfig
 from .description import UrdfJoint, read_joints, read_links
 from .gravity import GravityModel
+from .kinematics import IKConfig
 from .parts import Gripper, RobotArm
 from .trajectory import QuinticTrajectory
 

@@ -24,7 +24,6 @@ so the generated file says where each number came from.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
@@ -32,6 +31,15 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from ..inertia import (
+    box_inertia,
+    box_volume,
+    cylinder_inertia,
+    cylinder_volume,
+    sphere_inertia,
+    sphere_volume,
+)
 
 __all__ = ["Geom", "Link", "Joint", "UrdfBuilder", "shape_inertia", "composite_inertia"]
 
@@ -51,26 +59,25 @@ class Geom:
 
     def volume(self) -> float:
         if self.kind == "box":
-            return float(np.prod(self.size))
+            return box_volume(self.size)
         if self.kind == "cylinder":
             r, length = self.size
-            return math.pi * r * r * length
+            return cylinder_volume(r, length)
         (r,) = self.size
-        return 4.0 / 3.0 * math.pi * r**3
+        return sphere_volume(r)
 
 
 def shape_inertia(g: Geom, mass: float) -> np.ndarray:
-    """Inertia tensor (3x3) of a uniform solid about its own centre, in the link frame."""
+    """Inertia tensor (3x3) of a uniform solid about its own centre, in the link frame
+    (the primitive's moments from :mod:`benchharness.inertia`, turned by ``rpy``)."""
     if g.kind == "box":
-        x, y, z = g.size
-        d = mass / 12.0 * np.array([y * y + z * z, x * x + z * z, x * x + y * y])
+        d = box_inertia(mass, g.size)
     elif g.kind == "cylinder":
         r, h = g.size
-        ixx = mass * (3 * r * r + h * h) / 12.0
-        d = np.array([ixx, ixx, 0.5 * mass * r * r])
+        d = cylinder_inertia(mass, r, h)
     else:
         (r,) = g.size
-        d = np.full(3, 0.4 * mass * r * r)
+        d = sphere_inertia(mass, r)
     R = Rotation.from_euler("xyz", g.rpy).as_matrix()
     return R @ np.diag(d) @ R.T
 

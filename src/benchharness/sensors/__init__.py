@@ -5,10 +5,10 @@
 * :mod:`.camera` — :class:`HeadCamera`, the one-shot initial estimate;
 * :mod:`.pretouch` — :class:`PreTouchSensor` (ToF emitters on a link, batched
   ray casts) and :func:`scan` (readings along a path);
-* :mod:`.sweep` — :func:`face_sweep`, scan paths planned from an estimate;
+* :mod:`.scan_path` — :func:`face_sweep`, scan paths planned from an estimate;
 * :mod:`.raybox` — analytic ray–box ranges and their Jacobian;
-* :mod:`.estimate` — :class:`PoseEstimate`, mean pose plus covariance;
-* :mod:`.estimator` — :class:`CubePoseFilter`, the EKF (needs filterpy, which
+* :mod:`.pose_estimate` — :class:`PoseEstimate`, mean pose plus covariance;
+* :mod:`.cube_filter` — :class:`CubePoseFilter`, the EKF (needs filterpy, which
   is imported only when the filter is first used);
 * :mod:`.yaw` — the cube's yaw modulo its 90° symmetry.
 
@@ -21,14 +21,14 @@ from typing import TYPE_CHECKING, Any
 
 from .camera import HeadCamera
 from .config import CubeFilterConfig, HeadCameraConfig, ToFConfig
-from .estimate import CAMERA_AXES, FILTER_AXES, PoseEstimate
+from .pose_estimate import CAMERA_AXES, FILTER_AXES, PoseEstimate
 from .pretouch import Emitter, PreTouchSensor, Scan, ToFReading, free_body_mover, scan
 from .raybox import RayBoxHits, ray_box, ray_box_jacobian
-from .sweep import VERTICAL_FACES, face_sweep
+from .scan_path import VERTICAL_FACES, face_sweep
 from .yaw import cube_tilt, cube_yaw, wrap_quarter, yaw_error
 
 if TYPE_CHECKING:
-    from .estimator import CubePoseFilter, UpdateReport
+    from .cube_filter import CubePoseFilter, UpdateReport
 
 __all__ = [
     "CAMERA_AXES",
@@ -60,7 +60,7 @@ __all__ = [
 
 def __getattr__(name: str) -> Any:
     if name in ("CubePoseFilter", "UpdateReport"):
-        from . import estimator
+        from . import cube_filter
 
-        return getattr(estimator, name)
+        return getattr(cube_filter, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

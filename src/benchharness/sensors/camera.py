@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 from ..backends.interface import Backend, BodyId
 from ..geometry import Pose
 from .config import HeadCameraConfig
-from .estimate import CAMERA_AXES, PoseEstimate
+from .pose_estimate import CAMERA_AXES, PoseEstimate
 
 __all__ = ["HeadCamera"]
 

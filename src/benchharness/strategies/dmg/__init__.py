@@ -11,10 +11,11 @@ patches, planned as a shortest path. See ``docs/dmg.md``.
 Modules: :mod:`.config` (parameters), :mod:`.patches` (surface
 discretisation), :mod:`.graph` (construction, "DMG time"), :mod:`.planner`
 (queries, "Plan time"), :mod:`.placement` (published data on our meshes),
-:mod:`.runner` (the strategy object, results files), :mod:`.execution`
+:mod:`.strategy` (the strategy object, results files), :mod:`.execution`
 (executing plans on a simulator with the ``pr2-gripper``: the strategy's
-``run_trial``), :mod:`.regions` (the Level II task set and the
-contact-region errors of executed trials). Importing this package is cheap:
+``run_trial``). The Level II task set and the contact-region errors of
+stored trials are scoring, in :mod:`benchharness.runner.contact_regions`.
+Importing this package is cheap:
 trimesh/networkx load inside the factory's products.
 """
 
@@ -26,8 +27,8 @@ __all__ = ["REGISTRATIONS", "make_planner"]
 
 
 def make_planner(**kwargs):
-    """Strategy factory: a :class:`~.runner.DMGPlanner` (keyword arguments pass through)."""
-    from .runner import DMGPlanner
+    """Strategy factory: a :class:`~.strategy.DMGPlanner` (keyword arguments pass through)."""
+    from .strategy import DMGPlanner
 
     return DMGPlanner(**kwargs)
 

@@ -40,7 +40,7 @@ from filterpy.kalman import ExtendedKalmanFilter
 
 from ..geometry import Pose
 from .config import CubeFilterConfig, ToFConfig
-from .estimate import FILTER_AXES, PoseEstimate
+from .pose_estimate import FILTER_AXES, PoseEstimate
 from .pretouch import Scan, ToFReading
 from .raybox import ray_box, ray_box_jacobian
 from .yaw import cube_tilt, cube_yaw, level_rotation, wrap_quarter

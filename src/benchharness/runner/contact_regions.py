@@ -1,11 +1,19 @@
-"""Contact regions on our meshes: the Level II task set and the contact-region errors of executed trials.
+"""Contact regions on our meshes: the Level II task set and the contact-region errors of stored trials.
+
+This is scoring, not planning, so it lives in the runner beside the pose
+scoring (:mod:`.scoring`) and the CLI reaches it without importing a
+strategy. What it borrows from the DMG package is object data only: the
+placement of our mesh in the published task frame
+(:mod:`benchharness.strategies.dmg.placement`), the contacts put on the
+surface along the closing line (:func:`~benchharness.strategies.dmg.planner.surface_contacts`)
+and the two radii below, which the DMG's results files use as well.
 
 **Level II tasks** (``tasks/inhand/level2_dmg_regions.csv``, task set
 ``inhand-level2-dmg-regions``): the paper's Level II gives the desired
 contact region ``C_d`` only. We derive it from the four published DMG tasks:
 same initial grasp (pose and contacts), no desired hand pose (empty
 columns, level 2), and ``C_d`` = the union of two geodesic discs of radius
-``region_radius`` (:data:`~.runner.DESIRED_REGION_RADIUS`, 5 mm: about half a
+``region_radius`` (:data:`~benchharness.strategies.dmg.strategy.DESIRED_REGION_RADIUS`, 5 mm: about half a
 finger pad) on our mesh, centred where the published desired contacts fall
 on our surface along the line through them (the fingers' closing line). The
 disc centres are kept as ``desired_contact1/2`` so the file stays readable
@@ -15,18 +23,24 @@ without meshes; the region is rebuilt on the mesh by :func:`desired_region`.
 (:func:`benchharness.metrics.contact.contact_region_error`) between ``C_d``
 and the two finger pads as they touched the object at the end of the trial
 (5 mm geodesic discs around the measured contact points,
-:data:`~.runner.FINGER_PAD_RADIUS`), on our mesh placed in the task frame --
-the same construction :func:`.runner.results_for_grasps` uses for planned
+:data:`~benchharness.strategies.dmg.strategy.FINGER_PAD_RADIUS`), on our mesh placed in the task frame --
+the same construction :func:`~benchharness.strategies.dmg.strategy.results_for_grasps` uses for planned
 grasps, so planned and executed figures compare. The runner scores poses
-only; :func:`score_store` adds G_euc / G_geo / G_min to stored trials.
+only; :func:`score_store` (``benchharness inhand regions``) and
+:func:`stored_contact_scorer` (the Table III columns of ``benchharness table``)
+add G_euc / G_geo / G_min to stored trials.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..metrics.contact import GeodesicMethod
 
 __all__ = [
     "REGION_TASK_FILE",
@@ -35,6 +49,7 @@ __all__ = [
     "desired_region",
     "contact_errors",
     "score_store",
+    "stored_contact_scorer",
 ]
 
 REGION_TASK_FILE = "level2_dmg_regions.csv"
@@ -42,10 +57,10 @@ REGION_TASK_FILE = "level2_dmg_regions.csv"
 
 def derive_region_tasks(level3_path: str | Path | None = None):
     """The Level II :class:`~benchharness.inhand.records.TaskSet` from the published DMG tasks."""
-    from ...inhand.fileformat import read_tasks
-    from ...inhand.records import TaskSet
-    from ...paths import tasks_dir
-    from .runner import DESIRED_REGION_RADIUS
+    from ..inhand.fileformat import read_tasks
+    from ..inhand.records import TaskSet
+    from ..paths import tasks_dir
+    from ..strategies.dmg.strategy import DESIRED_REGION_RADIUS
 
     src = read_tasks(
         Path(level3_path) if level3_path else tasks_dir() / "inhand" / "level3_dmg_tasks.csv"
@@ -68,7 +83,7 @@ def derive_region_tasks(level3_path: str | Path | None = None):
 
 def write_region_tasks(path: str | Path) -> Path:
     """Write the Level II task file to ``path`` (no default: the tracked file is rewritten only when named)."""
-    from ...inhand.fileformat import write_tasks
+    from ..inhand.fileformat import write_tasks
 
     path = Path(path)
     write_tasks(derive_region_tasks(), path)
@@ -76,7 +91,7 @@ def write_region_tasks(path: str | Path) -> Path:
 
 
 def _mesh_in_task_frame(obj: str, planner=None):
-    from .runner import DMGPlanner
+    from ..strategies.dmg.strategy import DMGPlanner
 
     planner = planner or DMGPlanner()
     return planner.placement(obj).mesh_in_published(planner.mesh_for(obj))
@@ -85,8 +100,8 @@ def _mesh_in_task_frame(obj: str, planner=None):
 def desired_region(mesh, desired_contacts: np.ndarray, radius: float) -> np.ndarray:
     """Vertex indices of ``C_d``: geodesic discs of ``radius`` around the desired contacts put on ``mesh``
     along the line through them."""
-    from ...objects import contact_region
-    from .planner import surface_contacts
+    from ..objects import contact_region
+    from ..strategies.dmg.planner import surface_contacts
 
     c = np.asarray(desired_contacts, float)[:2]
     z = c[1] - c[0]
@@ -105,12 +120,12 @@ def contact_errors(
     radius: float | None = None,
     pad_radius: float | None = None,
     planner=None,
-    method: str = "heat",
+    method: GeodesicMethod = "heat",
 ) -> dict[str, float]:
     """G_euc, G_geo, G_min (m) of one trial, all in the task frame (see the module docstring)."""
-    from ...metrics.contact import contact_region_error
-    from ...objects import contact_region
-    from .runner import DESIRED_REGION_RADIUS, FINGER_PAD_RADIUS
+    from ..metrics.contact import contact_region_error
+    from ..objects import contact_region
+    from ..strategies.dmg.strategy import DESIRED_REGION_RADIUS, FINGER_PAD_RADIUS
 
     mesh = _mesh_in_task_frame(obj, planner)
     region = desired_region(
@@ -142,7 +157,7 @@ def score_store(
     import json
     import sqlite3
 
-    from ...plugin import get_manager
+    from ..plugin import get_manager
 
     path = Path(store)
     if not path.is_file():
@@ -187,10 +202,35 @@ def score_store(
     return out
 
 
-if __name__ == "__main__":  # pragma: no cover - the old entry point, kept as a pointer
-    import sys
+def stored_contact_scorer() -> Callable[[Any], dict[str, float] | None]:
+    """G_euc / G_geo / G_min of a stored trial with reached contacts, on our mesh in the task frame.
 
-    sys.exit(
-        "error: this module is no longer a command; use `benchharness inhand regions STORE` "
-        "(contact-region errors) or `benchharness inhand region-tasks --out PATH` (the task file)"
-    )
+    The ``contact_scorer`` of :func:`~benchharness.runner.reports.inhand_table3`
+    (``benchharness table``): desired contacts come from the task-set plugin
+    named by the trial's run, read once per task. A trial without reached
+    contacts, or whose task set gives no finite desired contacts for it,
+    scores None (the table prints no G for it).
+    """
+    from ..plugin import get_manager
+
+    desired: dict[str, dict[str, Any]] = {}
+
+    def score(trial) -> dict[str, float] | None:
+        o = trial.outcome
+        rc = o.get("reached_contacts")
+        if not rc:
+            return None
+        if trial.task not in desired:
+            try:
+                ts = get_manager().create("task", trial.task)
+                desired[trial.task] = {
+                    str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)
+                }
+            except Exception:  # noqa: BLE001 - not an in-hand task set with contacts
+                desired[trial.task] = {}
+        want = desired[trial.task].get(o.get("task_id"))
+        if want is None or not np.all(np.isfinite(np.asarray(want, float))):
+            return None
+        return contact_errors(o["object"], want, rc)
+
+    return score
