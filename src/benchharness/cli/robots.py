@@ -69,7 +69,7 @@ def _parse_joints(text: str, rob: Any) -> dict[str, float]:
 def robots_cmd(as_json: bool) -> None:
     """List registered robots: name, DOF, joint groups, providing distribution."""
     items = get_manager().items("robot")
-    rows = [
+    rows: list[dict[str, Any]] = [
         {
             "name": it.name,
             "dof": it.meta.get("dof"),
