@@ -369,7 +369,12 @@ def draw_robot(
     FigureCanvasAgg(fig)
     fs = max(7.0, min(width_px, 2 * height_px) / 140)
     fig.suptitle(
-        title or f"{robot.name}: collision geometry, one colour per link",
+        title
+        or (
+            f"{robot.name}: collision geometry, one colour per link, "
+            + (f"home pose except {', '.join(sorted(q))}" if q else "home pose")
+            + ("; joint frames x red, y green, z blue" if frames else "")
+        ),
         fontsize=fs * 1.25,
         y=0.985,
     )
