@@ -8,6 +8,7 @@ plugin manager, exactly as a benchmark run would.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 import numpy as np
@@ -17,8 +18,50 @@ from ..plugin import get_manager
 from .common import EXIT_BAD_INPUT, emit_json, fail, json_option, print_table
 from .common import console as rich_console
 
-#: The backend that renders snapshots when the chosen one cannot (PyBullet's TinyRenderer is headless).
-RENDER_FALLBACK = "pybullet"
+#: Default size of ``robot inspect --png`` (pixels, width x height): two square-ish panels.
+PNG_SIZE = (1400, 700)
+_MIN_PNG, _MAX_PNG = 300, 8000
+
+
+def _parse_size(ctx: click.Context, param: click.Parameter, value: str) -> tuple[int, int]:
+    """``WxH`` in pixels, each within [300, 8000]."""
+    parts = value.lower().split("x")
+    try:
+        w, h = (int(p) for p in parts) if len(parts) == 2 else (0, 0)
+    except ValueError:
+        w, h = 0, 0
+    if not (_MIN_PNG <= w <= _MAX_PNG and _MIN_PNG <= h <= _MAX_PNG):
+        raise click.BadParameter(
+            f"{value!r} is not WIDTHxHEIGHT in pixels, each {_MIN_PNG}..{_MAX_PNG} (e.g. 1400x700)"
+        )
+    return w, h
+
+
+def _parse_joints(text: str, rob: Any) -> dict[str, float]:
+    """``name=value,...`` (radians or metres) -> values, checked against ``rob``'s joints and
+    hard limits; a bad item exits 2 naming it."""
+    out: dict[str, float] = {}
+    for item in (t.strip() for t in text.split(",")):
+        if not item:
+            continue
+        name, sep, val = item.partition("=")
+        name = name.strip()
+        if not sep:
+            fail(f"--joints {item!r}: expected name=value")
+        if name not in rob.urdf_joints:
+            fail(
+                f"--joints {item!r}: robot {rob.name!r} has no movable joint {name!r} "
+                f"(its joints: {', '.join(rob.joint_names)})"
+            )
+        try:
+            x = float(val)
+        except ValueError:
+            fail(f"--joints {item!r}: {val.strip()!r} is not a number")
+        j = rob.urdf_joints[name]
+        if not np.isfinite(x) or not (j.lower - 1e-9 <= x <= j.upper + 1e-9):
+            fail(f"--joints {item!r}: outside joint {name!r}'s limits [{j.lower:g}, {j.upper:g}]")
+        out[name] = x
+    return out
 
 
 @click.command("robots")
@@ -26,7 +69,7 @@ RENDER_FALLBACK = "pybullet"
 def robots_cmd(as_json: bool) -> None:
     """List registered robots: name, DOF, joint groups, providing distribution."""
     items = get_manager().items("robot")
-    rows = [
+    rows: list[dict[str, Any]] = [
         {
             "name": it.name,
             "dof": it.meta.get("dof"),
@@ -58,49 +101,6 @@ def robot() -> None:
     """Inspect one robot."""
 
 
-def _camera_for(points: np.ndarray):
-    """A camera that frames all ``points`` (world link origins) from the front-left, slightly above."""
-    from ..backends.interface import CameraSpec
-
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    centre = (lo + hi) / 2
-    radius = max(float(np.linalg.norm(hi - lo)) / 2, 0.08) + 0.05
-    fov = 50.0
-    dist = radius / np.tan(np.radians(fov / 2)) * 1.1
-    direction = np.array([1.0, 0.45, 0.5])
-    direction /= np.linalg.norm(direction)
-    eye = centre + direction * dist
-    return CameraSpec(
-        eye=tuple(eye),
-        target=tuple(centre),
-        width=640,
-        height=480,
-        fov_deg=fov,
-        near=0.01,
-        far=float(dist + 3 * radius),
-    )
-
-
-def _snapshot(robot_name: str, backend_name: str, png: Path) -> str:
-    """Render the robot in its home pose to ``png``; returns the backend that rendered."""
-    import matplotlib.image
-
-    manager = get_manager()
-    item = manager.get("backend", backend_name)
-    renderer = backend_name if item.meta.get("capabilities", {}).get("camera") else RENDER_FALLBACK
-    be = manager.create("backend", renderer)
-    try:
-        r = manager.create("robot", robot_name)
-        r.spawn(be)
-        pts = np.array([be.get_link_pose(r.body, lk).p for lk in r.link_names])
-        img = be.render(_camera_for(pts))
-        png.parent.mkdir(parents=True, exist_ok=True)
-        matplotlib.image.imsave(str(png), np.asarray(img, dtype=np.uint8))
-    finally:
-        be.close()
-    return renderer
-
-
 @robot.command("inspect")
 @click.argument("name")
 @click.option(
@@ -114,16 +114,58 @@ def _snapshot(robot_name: str, backend_name: str, png: Path) -> str:
     "--png",
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
-    help="Save a snapshot of the robot in its home pose.",
+    help="Draw the robot's geometry (side and top view, one colour per link) into this PNG; "
+    "its folder must exist.",
+)
+@click.option(
+    "--size",
+    default=f"{PNG_SIZE[0]}x{PNG_SIZE[1]}",
+    show_default=True,
+    callback=_parse_size,
+    help="Size of the --png image in pixels, WIDTHxHEIGHT.",
+)
+@click.option(
+    "--frames", is_flag=True, help="--png: draw an RGB (x, y, z) triad at every movable joint."
+)
+@click.option("--frame-labels", is_flag=True, help="--png: label the triads with joint names.")
+@click.option(
+    "--joints",
+    "joints_text",
+    default=None,
+    metavar="NAME=VALUE,...",
+    help="--png: draw at these joint values (rad or m; the others stay at home).",
 )
 @json_option
-def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -> None:
-    """Load robot NAME on a backend: DOF, joint limits, groups and tool frames in the home pose."""
+def inspect_cmd(
+    name: str,
+    backend_name: str,
+    png: Path | None,
+    size: tuple[int, int],
+    frames: bool,
+    frame_labels: bool,
+    joints_text: str | None,
+    as_json: bool,
+) -> None:
+    """Load robot NAME on a backend: DOF, joint limits, groups and tool frames in the home pose.
+
+    --png draws the robot without a simulator camera (headless, deterministic):
+    its URDF collision shapes, posed by our FK at the home configuration (or
+    --joints), in a side view (from -y) and a top view (from +z) with the
+    floor and metre axes; --frames adds joint frames.
+    """
     from ..plugin.manager import PluginNotFoundError
 
+    if png is not None and not png.parent.is_dir():
+        fail(f"--png {png}: folder {png.parent} does not exist")
+    if png is None and (frames or frame_labels or joints_text):
+        fail("--frames, --frame-labels and --joints only apply with --png")
     manager = get_manager()
     try:
         rob = manager.create("robot", name)
+    except PluginNotFoundError as exc:
+        fail(str(exc), EXIT_BAD_INPUT)
+    q_draw = _parse_joints(joints_text, rob) if joints_text else {}
+    try:
         be = manager.create("backend", backend_name)
     except PluginNotFoundError as exc:
         fail(str(exc), EXIT_BAD_INPUT)
@@ -164,8 +206,11 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
         },
     }
     if png is not None:
+        from ..robots.sketch import draw_robot
+
+        drawn = draw_robot(rob, png, q=q_draw, size=size, frames=frames, frame_labels=frame_labels)
         data["png"] = str(png)
-        data["rendered_by"] = _snapshot(name, backend_name, png)
+        data["drawing"] = {**drawn.as_dict(), "joints": q_draw}
     if as_json:
         emit_json(data)
         return
@@ -206,11 +251,10 @@ def inspect_cmd(name: str, backend_name: str, png: Path | None, as_json: bool) -
         )
     print_table(f, con)
     if png is not None:
-        note = (
-            ""
-            if data["rendered_by"] == backend_name
-            else (
-                f" (backend {backend_name!r} cannot render: snapshot rendered through {data['rendered_by']!r})"
-            )
+        at = ", ".join(f"{k}={v:g}" for k, v in q_draw.items())
+        con.print(
+            f"drawing: {png} ({size[0]}x{size[1]} px; side and top view; "
+            + (f"home pose but {at}" if at else "home pose")
+            + (", joint frames" if frames else "")
+            + ")"
         )
-        con.print(f"snapshot: {png}{note}")
