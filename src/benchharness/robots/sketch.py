@@ -5,7 +5,7 @@ without a simulator camera, so it works the same on a headless CPU machine and
 is deterministic: every link's ``<collision>`` shapes (its ``<visual>`` ones
 where it has no collision shape) are tessellated (boxes, cylinders, spheres;
 meshes through trimesh), placed at the link poses that
-:class:`~benchharness.kinematics.KinematicTree` gives for the chosen joint
+:class:`~benchharness.robots.kinematics.KinematicTree` gives for the chosen joint
 values and the robot's base pose, and projected orthographically onto two
 panels:
 
@@ -245,10 +245,10 @@ def read_link_shapes(urdf: str | Path) -> dict[str, list[tuple[np.ndarray, LinkS
 def robot_link_poses(robot: Any, q: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
     """World 4x4 pose of every link of ``robot`` (a :class:`Robot`) at ``q`` (default: home).
 
-    Our FK (:class:`~benchharness.kinematics.KinematicTree`, URDF root frame)
+    Our FK (:class:`~benchharness.robots.kinematics.KinematicTree`, URDF root frame)
     composed with the robot's configured base pose; no simulator.
     """
-    from ..kinematics import KinematicTree
+    from .kinematics import KinematicTree
 
     joints = dict(zip(robot.joint_names, (float(v) for v in robot.home())))
     joints.update(q or {})
