@@ -16,6 +16,9 @@ Sources (files read with ``git show <commit>:<path>``):
   ``urdf/shoulder_v0/shoulder.urdf.xacro``, ``urdf/upper_arm_v0/upper_arm.urdf.xacro``,
   ``urdf/forearm_v0/forearm.urdf.xacro``, ``urdf/gripper_v0/gripper.urdf.xacro``
   (``*_gripper_tool_joint`` ``0.18 0 0``).
+  The gripper's finger macro ``pr2_finger_v0`` (finger and fingertip joint origins and
+  axes, all mimicking ``*_l_finger_joint``) and the pad mesh
+  ``meshes/gripper_v0/finger_tip_pad2_l.stl`` (its inner face), same file and commit.
 * Allegro: github.com/simlabrobotics/allegro_hand_ros_v4 at
   b19b18ea130c4fbe343f2c178eec6cb55186a4ac,
   ``src/allegro_hand_description/allegro_hand_description_right.urdf``
@@ -35,6 +38,7 @@ from scipy.spatial.transform import Rotation
 
 from benchharness.geometry import Pose
 from benchharness.paths import robots_dir
+from benchharness.robots.descriptions.pr2 import PAD_GAP
 from benchharness.robots.kinematics import KinematicTree, pose_error
 
 POS_TOL = 1e-3  # m
@@ -571,6 +575,144 @@ def _allegro_samples(n: int, seed: int) -> list[dict[str, float]]:
     return [
         {j: float(rng.uniform(lo, hi)) for j, (lo, hi) in ALLEGRO_LIMITS.items()} for _ in range(n)
     ]
+
+
+# -- PR2 gripper: the four-bar fingers -------------------------------------------------------------
+
+
+#: pr2_description ``urdf/gripper_v0/gripper.urdf.xacro`` (same commit): the finger macro
+#: ``pr2_finger_v0``. Every finger joint mimics ``*_l_finger_joint`` with multiplier +1; the axes make
+#: the proximal links open outwards and the fingertips turn back by the same angle.
+def _gripper_published(s: str) -> list[tuple]:
+    z3 = (0.0, 0.0, 0.0)
+    palm = f"{s}_gripper_palm_link"
+    return [
+        (
+            f"{s}_gripper_l_finger_joint",
+            "revolute",
+            palm,
+            f"{s}_gripper_l_finger_link",
+            (0.07691, 0.01, 0),
+            z3,
+            (0, 0, 1),
+        ),
+        (
+            f"{s}_gripper_r_finger_joint",
+            "revolute",
+            palm,
+            f"{s}_gripper_r_finger_link",
+            (0.07691, -0.01, 0),
+            z3,
+            (0, 0, -1),
+        ),
+        (
+            f"{s}_gripper_l_finger_tip_joint",
+            "revolute",
+            f"{s}_gripper_l_finger_link",
+            f"{s}_gripper_l_finger_tip_link",
+            (0.09137, 0.00495, 0),
+            z3,
+            (0, 0, -1),
+        ),
+        (
+            f"{s}_gripper_r_finger_tip_joint",
+            "revolute",
+            f"{s}_gripper_r_finger_link",
+            f"{s}_gripper_r_finger_tip_link",
+            (0.09137, -0.00495, 0),
+            z3,
+            (0, 0, 1),
+        ),
+    ]
+
+
+#: Centre of each pad's contact face in its fingertip frame: ``meshes/gripper_v0/finger_tip_pad2_l.stl``
+#: (same commit) spans x -0.00475..0.03125 with its inner face at y = -0.01495 (read with trimesh);
+#: the right fingertip shows the mesh turned by pi about x (``rpy="${M_PI} 0 0"``), so its face is at +y.
+PAD_FACE_IN_TIP = {"l": np.array([0.01325, -0.01495, 0.0]), "r": np.array([0.01325, 0.01495, 0.0])}
+
+
+def _gripper_oracle(
+    s: str, theta: float
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], float]:
+    """Fingertip frames and pad-face centres (palm frame) at finger angle ``theta``, and the opening."""
+    q = {j[0]: theta for j in _gripper_published(s)}
+    poses = oracle_fk(_gripper_published(s), q, f"{s}_gripper_palm_link")
+    tips = {f: poses[f"{s}_gripper_{f}_finger_tip_link"] for f in "lr"}
+    faces = {f: tips[f][:3, :3] @ PAD_FACE_IN_TIP[f] + tips[f][:3, 3] for f in "lr"}
+    return tips, faces, float(faces["l"][1] - faces["r"][1])
+
+
+def _our_pad_faces(pr2_urdf: str, s: str) -> dict[str, np.ndarray]:
+    """Inner-face centre of each fingertip's pad box in its link frame, read from our URDF."""
+    root = ET.fromstring(pr2_urdf)
+    out = {}
+    for f, sign in (("l", 1.0), ("r", -1.0)):
+        link = next(
+            lk
+            for lk in root.findall("link")
+            if lk.get("name") == f"{s}_gripper_{f}_finger_tip_link"
+        )
+        col = link.find("collision")
+        xyz = np.array([float(v) for v in col.find("origin").get("xyz").split()])
+        size = np.array([float(v) for v in col.find("geometry/box").get("size").split()])
+        out[f] = xyz - sign * np.array([0.0, size[1] / 2, 0.0])  # the face towards the other pad
+    return out
+
+
+#: finger angles sampled over the range our 2..90 mm opening covers (published limit 0..0.548 rad)
+GRIPPER_THETAS = (0.02, 0.1, 0.2, 0.3, 0.4, 0.5)
+
+
+def test_pr2_gripper_pads_match_the_published_four_bar(robots):
+    """At each sampled finger angle of the published linkage, our fingertip frames and pad faces (FK,
+    the fingers set to the published opening, the fingertips where the linkage puts them) lie within
+    1 mm / 0.5 deg of the published ones: parallel to the palm, sliding along the approach."""
+    pr2 = robots["pr2"]
+    tree = KinematicTree(pr2.urdf_text)
+    faces_ours = _our_pad_faces(pr2.urdf_text, "l")
+    names = pr2.joint_names
+    xs = []
+    for theta in GRIPPER_THETAS:
+        tips, faces, opening = _gripper_oracle("l", theta)
+        q = pr2.home()
+        for f in "lr":
+            q[names.index(f"l_gripper_{f}_finger_joint")] = opening / 2 - PAD_GAP
+        q = pr2.with_linkages(q)
+        ours = tree.fk(dict(zip(names, q)))
+        palm = ours["l_gripper_palm_link"]
+        for f in "lr":
+            tip = np.linalg.inv(palm) @ ours[f"l_gripper_{f}_finger_tip_link"]
+            _assert_close(tip, tips[f], f"FK fingertip {f} at theta {theta}")
+            face = tip[:3, :3] @ faces_ours[f] + tip[:3, 3]
+            assert np.linalg.norm(face - faces[f]) < POS_TOL, (f, theta, face, faces[f])
+        xs.append(faces["l"][0])
+    # the published pads travel back along the approach as the gripper opens: 13 mm over the range
+    assert np.all(np.diff(xs) < 0) and xs[0] - xs[-1] > 0.01
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("backend", ("pybullet", "sapien"))
+def test_pr2_gripper_pads_on_the_engines_match_the_published_four_bar(
+    make_backend, make_robot, backend
+):
+    """The same on each engine: the gripper commanded to each published opening and driven there
+    (the fingertips following through the controller), link poses read back from the engine."""
+    be = make_backend(backend)
+    pr2 = make_robot("pr2")
+    pr2.spawn(be)
+    g = pr2.gripper("left_gripper")
+    for theta in GRIPPER_THETAS[::-1]:  # closing, as a grasp does
+        tips, _, opening = _gripper_oracle("l", theta)
+        g.set_command([opening / 2 - PAD_GAP])
+        pr2.step(int(0.5 / be.config.timestep))
+        palm = be.get_link_pose(pr2.body, "l_gripper_palm_link").as_matrix()
+        for f in "lr":
+            tip = (
+                np.linalg.inv(palm)
+                @ be.get_link_pose(pr2.body, f"l_gripper_{f}_finger_tip_link").as_matrix()
+            )
+            _assert_close(tip, tips[f], f"{backend} fingertip {f} at theta {theta}")
 
 
 def test_allegro_fk_matches_published_description(robots):
