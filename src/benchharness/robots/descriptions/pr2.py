@@ -17,9 +17,15 @@ published; the harness's IK and motion primitives respect the soft limits
 (``RobotConfig.soft_limits``), the engines the hard ones.
 
 Simplifications (also in robots/pr2/README.md):
-* the gripper is two prismatic fingers (the real one is a four-bar linkage
-  whose pads stay parallel); the fingers are coupled in the controller, not
-  by ``<mimic>`` (PhysX has no mimic joints);
+* the gripper's four-bar fingers: each finger is a lateral prismatic joint
+  (the commanded half opening) carrying a fingertip slide along the approach
+  that the controller keeps on the linkage's arc (``FingertipLinkage``), so
+  the fingertip frames and pads are where the published linkage puts them at
+  every opening, parallel to the palm; the proximal bar is a box that
+  translates with the finger (the real link turns), and a load along the
+  approach is carried by the fingertip's stiff drive, not the linkage. The
+  fingers are coupled in the controller, not by ``<mimic>`` (PhysX has no
+  mimic joints);
 * forearm roll and wrist roll are ``continuous``, as on the robot: a twist
   or a hand-over turn can carry on past +/-pi without the arm having to
   switch IK branch (unwind) mid-turn. IK searches them over +/-pi and

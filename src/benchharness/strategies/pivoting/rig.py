@@ -18,7 +18,7 @@ Why the object rests on the table while the grasp changes: with a light
 squeeze, the table holds the object (friction and its weight against
 tipping) while the pads slide or turn over it, so the change of grasp comes
 from contact physics rather than from a kinematic rule; gravity pivoting
-with flat 35 x 22 mm PR2 pads is not workable (the pads' torsional friction
+with flat 36 x 23 mm PR2 pads is not workable (the pads' torsional friction
 is of the order of ``2 mu F * 2 cm``, so the object only turns once it
 slips down as well). ``docs/pivoting.md`` discusses it.
 
@@ -402,7 +402,7 @@ class TableRig:
         hand z) cut with the object's surface, entry and exit points -- the
         fingertip contacts in the DMG's sense, from which the benchmark takes
         the hand position (their midpoint). Why not the engine's contact
-        points: a 35 x 22 mm pad touches over a patch whose reported points
+        points: a 36 x 23 mm pad touches over a patch whose reported points
         (2-4 corners, force-weighted) wander by up to a pad half-length with
         the pressure distribution; they are kept as
         :meth:`contact_points_object` for diagnostics.

@@ -50,7 +50,9 @@ __all__ = [
 #: object -> grasp (closing) axis in our object frame, chosen across two flat parallel faces
 PIVOT_OBJECTS = {"gelatin box": (1.0, 0.0, 0.0), "Lego Duplo": (0.0, 1.0, 0.0)}
 GRASP_DEPTH = (
-    0.020  #: m, tool centre point below the object's top: the 35 mm pads' half length + 2.5 mm
+    0.020  #: m, tool centre point below the object's top: the 36 mm pads' half length + 2 mm
+    # (their centre 0.3-0.7 mm behind the tool frame at these objects' 28-32 mm widths, so the
+    # pads' upper ends sit 1.3-1.7 mm below the top)
 )
 MAX_WIDTH = 0.080  #: m, PR2 gripper opening (90 mm) less 5 mm each side
 PIVOT_TASK_FILE = "level1_pivoting.csv"
