@@ -204,7 +204,7 @@ def choose_rest(model, poses: list[Pose], width: float, cfg: ExecutionConfig) ->
         return None, -np.inf
     opening = width + 0.03
     scored = [
-        (min(clearance(r * h, opening, cfg.motion.table_height) for h in poses), i, r)
+        (min(clearance(r * h, opening, cfg.motion.table_height, width) for h in poses), i, r)
         for i, r in enumerate(rests)
     ]
     c, _, rest = max(scored, key=lambda t: (t[0], -t[1]))

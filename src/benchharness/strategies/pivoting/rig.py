@@ -38,11 +38,12 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from ...geometry import Pose
-from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, TCP_X, finger_boxes
+from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, TCP_X, finger_boxes, pad_setback
 from .config import ExecutionConfig
 
 __all__ = [
     "HAND_IN_TCP",
+    "hand_in_tcp",
     "TableRig",
     "RigFailure",
     "gripper_boxes",
@@ -51,9 +52,19 @@ __all__ = [
     "HoldResult",
 ]
 
-#: The hand frame in the tool frame: x_h = x_tool, y_h = z_tool, z_h = -y_tool.
+#: The hand frame's axes in the tool frame: x_h = x_tool, y_h = z_tool, z_h = -y_tool.
 HAND_IN_TCP = Rotation.from_matrix([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
-_HAND_IN_TCP_POSE = Pose.from_rotation(np.zeros(3), HAND_IN_TCP)
+
+
+def hand_in_tcp(width: float) -> Pose:
+    """The hand (grasp) frame in the tool frame for an object ``width`` wide between the pads.
+
+    Its origin is the pads' centre when they close on that width: on the PR2's
+    four-bar fingers ``pad_setback(width)`` behind the tool frame (0.3 mm at
+    28 mm, 8.8 mm at 75 mm), so a hand pose puts the pads, not the tool frame,
+    on the grasp the task gives (the fingertip contacts' midpoint).
+    """
+    return Pose.from_rotation(np.array([-pad_setback(width), 0.0, 0.0]), HAND_IN_TCP)
 
 
 class RigFailure(Exception):
@@ -79,9 +90,10 @@ def gripper_boxes(opening: float) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def clearance(hand_world: Pose, opening: float, table_height: float = 0.0) -> float:
-    """Lowest point of the gripper above the table (m) with the hand at ``hand_world``."""
-    tcp = hand_world * _HAND_IN_TCP_POSE.inv()
+def clearance(hand_world: Pose, opening: float, table_height: float, grip_width: float) -> float:
+    """Lowest point of the gripper above the table (m): the hand frame of a ``grip_width`` grasp
+    (:func:`hand_in_tcp`) at ``hand_world``, the fingers ``opening`` apart."""
+    tcp = hand_world * hand_in_tcp(grip_width).inv()
     R, p = tcp.rotation.as_matrix(), tcp.p
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
     low = np.inf
@@ -162,6 +174,19 @@ class TableRig:
     rng: np.random.Generator
     body: int | None = None
     log: list = field(default_factory=list)
+    #: width (m) of the object between the pads, which places the hand frame (:func:`hand_in_tcp`);
+    #: set by :meth:`setup_grasp`
+    grip_width: float | None = None
+
+    @property
+    def _width(self) -> float:
+        if self.grip_width is None:
+            raise RuntimeError("the rig has no grasp yet: call setup_grasp first")
+        return self.grip_width
+
+    @property
+    def _hand_in_tcp(self) -> Pose:
+        return hand_in_tcp(self._width)
 
     # ------------------------------------------------------------------ scene
     def build(self, rest: Pose) -> None:
@@ -200,7 +225,7 @@ class TableRig:
         return Pose.from_rotation(pose.p + dp, Rotation.from_rotvec(dr) * pose.rotation)
 
     def hand_world(self) -> Pose:
-        return self.arm.tcp_pose() * _HAND_IN_TCP_POSE
+        return self.arm.tcp_pose() * self._hand_in_tcp
 
     def hand_in_object(self, noisy: bool = True) -> Pose:
         return self.object_pose(noisy).inv() * self.hand_world()
@@ -216,7 +241,7 @@ class TableRig:
 
         q = self.robot.home()
         names = self.robot.joint_names
-        qs = stage_joints_for(hand_world * _HAND_IN_TCP_POSE.inv())
+        qs = stage_joints_for(hand_world * self._hand_in_tcp.inv())
         for n, v in zip(self.arm.joints, qs):
             q[names.index(n)] = v
         half = max(0.0, min(FINGER_TRAVEL, opening / 2 - PAD_GAP))
@@ -282,7 +307,7 @@ class TableRig:
         targets = [self.hand_world()] + [obj * h for h in hand_in_object]
         m = self.config.motion
         for t in targets[1:]:
-            c = clearance(t, self.opening(), m.table_height)
+            c = clearance(t, self.opening(), m.table_height, self._width)
             if c < m.min_clearance:
                 raise RigFailure(
                     "unreachable",
@@ -309,6 +334,7 @@ class TableRig:
         tick = per * be.config.timestep
         n = int(math.ceil(duration / tick))
         joints = list(self.arm.joints)
+        in_tcp = self._hand_in_tcp
         q_prev = self.arm.positions()
         for k in range(1, n + 1):
             tau = min(1.0, k * tick / duration)
@@ -318,7 +344,7 @@ class TableRig:
             u = min(max(u, 0.0), 1.0)
             a, b = targets[i], targets[i + 1]
             pose = Pose.from_rotation(a.p + u * (b.p - a.p), slerps[i]([u])[0])
-            q = stage_joints_for(pose * _HAND_IN_TCP_POSE.inv(), previous=q_prev)
+            q = stage_joints_for(pose * in_tcp.inv(), previous=q_prev)
             robot.drive(joints, q, (q - q_prev) / tick)
             q_prev = q
             robot.step(per)
@@ -437,8 +463,9 @@ class TableRig:
         target = obj * noisy
         pre = Pose(target.p - target.rotation.apply([s.approach_clearance, 0.0, 0.0]), target.q)
         opening = min(2 * (FINGER_TRAVEL + PAD_GAP), width + 0.03)
+        self.grip_width = width
         for pose in (pre, target):
-            c = clearance(pose, opening, self.config.motion.table_height)
+            c = clearance(pose, opening, self.config.motion.table_height, width)
             if c < self.config.motion.min_clearance:
                 raise RigFailure(
                     "unreachable",

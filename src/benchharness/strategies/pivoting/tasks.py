@@ -88,7 +88,10 @@ def rest_pose(obj: str, grasp_axis, pivot: float = 0.0) -> Pose:
     for rest in rests:
         hi = initial_grasp(obj, grasp_axis, pivot, rest)
         hd = hi * Pose.from_rotation(np.zeros(3), Rotation.from_rotvec([0.0, 0.0, pivot]))
-        if min(clearance(rest * h, width + 0.03) for h in (hi, hd)) >= MotionConfig().min_clearance:
+        if (
+            min(clearance(rest * h, width + 0.03, 0.0, width) for h in (hi, hd))
+            >= MotionConfig().min_clearance
+        ):
             return rest
     raise ValueError(
         f"{obj}: no stable rest pose keeps the grasp axis {grasp_axis} horizontal with the gripper clear of the table"
