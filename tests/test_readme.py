@@ -1,4 +1,4 @@
-"""The README's console examples run and print what the README shows.
+"""The README's and docs/' console examples run and print what the page shows.
 
 Every ``$ benchharness ...`` line in a ```console block of the protocol,
 scoring and plugin sections is run from the repository root; each output line
@@ -28,6 +28,24 @@ def examples() -> list[tuple[str, list[str]]]:
     # The walkthroughs' commands read the store their own earlier commands
     # wrote; tests/test_readme_walkthroughs.py runs them in order.
     text = "\n### ".join(s for s in text.split("\n### ") if not s.startswith("Walkthrough"))
+    return _console_examples(text)
+
+
+#: pages whose examples have a test of their own (docs/rubiks.md: tests/test_rubiks_docs.py)
+DOCS_TESTED_ELSEWHERE = ("rubiks.md",)
+
+
+def doc_examples() -> list[tuple[str, str, list[str]]]:
+    """(page, command, shown output) of every console example in docs/ this test runs."""
+    out = []
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        if page.name in DOCS_TESTED_ELSEWHERE:
+            continue
+        out += [(page.name, c, e) for c, e in _console_examples(page.read_text())]
+    return out
+
+
+def _console_examples(text: str) -> list[tuple[str, list[str]]]:
     out: list[tuple[str, list[str]]] = []
     for block in re.findall(r"```console\n(.*?)```", text, flags=re.S):
         current: tuple[str, list[str]] | None = None
@@ -43,6 +61,26 @@ def examples() -> list[tuple[str, list[str]]]:
 
 @pytest.mark.parametrize("command,expected", examples(), ids=[c for c, _ in examples()])
 def test_readme_example(command, expected):
+    _check(command, expected)
+
+
+@pytest.mark.parametrize(
+    "page,command,expected", doc_examples(), ids=[f"{p}: {c}" for p, c, _ in doc_examples()]
+)
+def test_doc_example(page, command, expected):
+    _check(command, expected)
+
+
+def test_docs_have_checked_examples():
+    """The docs' console examples with output are found (docs/inhand.md's score table at least)."""
+    shown = [(p, c) for p, c, e in doc_examples() if e]
+    assert (
+        "inhand.md",
+        "benchharness inhand score tasks/inhand/published/yumi_lvl3_dmg.csv --by object",
+    ) in shown
+
+
+def _check(command: str, expected: list[str]) -> None:
     argv = shlex.split(command)
     assert argv[0] == "benchharness"
     proc = subprocess.run(
