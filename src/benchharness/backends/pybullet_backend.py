@@ -50,8 +50,9 @@ from .interface import (
     StepCallback,
 )
 
-#: the colour of a shape drawn without an ``rgba``
+#: the colour of a shape drawn without an ``rgba``, and of a URDF link without a ``<visual>`` colour
 _GREY = (0.45, 0.5, 0.6, 1.0)
+_URDF_GREY = (0.45, 0.47, 0.52, 1.0)
 
 
 def _rgb8(rgba: Sequence[float] | None) -> tuple[int, int, int]:
@@ -405,14 +406,10 @@ class PyBulletBackend(Backend):
     def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
         cid = self._cid
         shape = pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=[0, 0, 1], physicsClientId=cid)
-        vis = pb.createVisualShape(
-            pb.GEOM_BOX,
-            halfExtents=[5, 5, 0.0005],
-            visualFramePosition=[0, 0, -0.0005],
-            rgbaColor=[0.8, 0.8, 0.8, 1],
-            physicsClientId=cid,
-        )
-        uid = pb.createMultiBody(0.0, shape, vis, basePosition=[0, 0, height], physicsClientId=cid)
+        # Not drawn: filling most of a frame, a floor doubled TinyRenderer's time per 640 x 480
+        # image (measured 150 vs 60 ms, PR2 scene; BENCHMARKS.md, "Trial video"), and the
+        # renderer's light grey background reads as the floor anyway.
+        uid = pb.createMultiBody(0.0, shape, -1, basePosition=[0, 0, height], physicsClientId=cid)
         fr = self.config.default_friction if friction is None else friction
         pb.changeDynamics(
             uid, -1, lateralFriction=fr, spinningFriction=self._spinning(fr), physicsClientId=cid
@@ -733,6 +730,12 @@ class PyBulletBackend(Backend):
         )
         h = self._register(b)
         self.set_pose(h, base_pose)
+        # links drawn from their collision geometry (no <visual>) come out white: grey them,
+        # so a robot stands out from the background; a URDF's own visuals keep their colours
+        drawn = {int(v[1]) for v in pb.getVisualShapeData(uid, physicsClientId=cid)}
+        for i in range(-1, pb.getNumJoints(uid, physicsClientId=cid)):
+            if i not in drawn:
+                pb.changeVisualShape(uid, i, rgbaColor=list(_URDF_GREY), physicsClientId=cid)
         return h
 
     def remove_body(self, body: BodyId) -> None:
