@@ -408,8 +408,16 @@ class PyBulletBackend(Backend):
         shape = pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=[0, 0, 1], physicsClientId=cid)
         # Not drawn: filling most of a frame, a floor doubled TinyRenderer's time per 640 x 480
         # image (measured 150 vs 60 ms, PR2 scene; BENCHMARKS.md, "Trial video"), and the
-        # renderer's light grey background reads as the floor anyway.
-        uid = pb.createMultiBody(0.0, shape, -1, basePosition=[0, 0, height], physicsClientId=cid)
+        # renderer's light grey background reads as the floor anyway. Without a visual shape
+        # PyBullet would draw the plane as a checkerboard, so it gets a 1 mm box 1 m below.
+        vis = pb.createVisualShape(
+            pb.GEOM_BOX,
+            halfExtents=[0.0005] * 3,
+            visualFramePosition=[0, 0, -1.0],
+            rgbaColor=[0.8, 0.8, 0.8, 1],
+            physicsClientId=cid,
+        )
+        uid = pb.createMultiBody(0.0, shape, vis, basePosition=[0, 0, height], physicsClientId=cid)
         fr = self.config.default_friction if friction is None else friction
         pb.changeDynamics(
             uid, -1, lateralFriction=fr, spinningFriction=self._spinning(fr), physicsClientId=cid
@@ -730,12 +738,15 @@ class PyBulletBackend(Backend):
         )
         h = self._register(b)
         self.set_pose(h, base_pose)
-        # links drawn from their collision geometry (no <visual>) come out white: grey them,
-        # so a robot stands out from the background; a URDF's own visuals keep their colours
-        drawn = {int(v[1]) for v in pb.getVisualShapeData(uid, physicsClientId=cid)}
-        for i in range(-1, pb.getNumJoints(uid, physicsClientId=cid)):
-            if i not in drawn:
-                pb.changeVisualShape(uid, i, rgbaColor=list(_URDF_GREY), physicsClientId=cid)
+        # links drawn from their collision geometry (no <visual>) come out white: grey them, so
+        # a robot stands out from the background; a URDF's own (non-white) colours stay
+        white = {
+            int(v[1])
+            for v in pb.getVisualShapeData(uid, physicsClientId=cid)
+            if tuple(v[7]) == (1.0, 1.0, 1.0, 1.0)
+        }
+        for link in sorted(white):
+            pb.changeVisualShape(uid, link, rgbaColor=list(_URDF_GREY), physicsClientId=cid)
         return h
 
     def remove_body(self, body: BodyId) -> None:
@@ -1040,6 +1051,7 @@ class PyBulletBackend(Backend):
             view,
             proj,
             renderer=pb.ER_TINY_RENDERER,
+            flags=pb.ER_NO_SEGMENTATION_MASK,  # only the colours are returned
             physicsClientId=self._cid,
         )
         img = np.asarray(rgba, dtype=np.uint8).reshape(camera.height, camera.width, 4)
