@@ -121,13 +121,13 @@ def test_video_mp4_and_a_clear_error_without_a_camera(invoke, tmp_path):
     data = _json(r)
     info, sim_s = data["video"], data["trials"][0]["sim_s"]
     # frame k shows the world once k / fps simulated seconds have passed: ceil(duration x fps)
-    assert info["fps"] == 10 and info["view"] == "close" and info["size"] == [480, 360]
-    assert info["frames"] == math.ceil(sim_s * 10 - 1e-6) >= 3
+    assert info["fps"] == 8 and info["view"] == "close" and info["size"] == [400, 300]
+    assert info["frames"] == math.ceil(sim_s * 8 - 1e-6) >= 2
     assert mp4.read_bytes()[4:8] == b"ftyp"
     import imageio_ffmpeg
 
     n, secs = imageio_ffmpeg.count_frames_and_secs(str(mp4))  # decoded by ffmpeg: a valid MP4
-    assert n == info["frames"] and secs == pytest.approx(n / 10, abs=0.05)
+    assert n == info["frames"] and secs == pytest.approx(n / 8, abs=0.05)
     r = invoke(
         run,
         "--task",

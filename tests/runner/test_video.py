@@ -33,7 +33,7 @@ def _json(result):
 
 def test_burn_in_draws_a_readable_box_and_nothing_else():
     frame = np.full((480, 640, 3), 180, dtype=np.uint8)
-    out = burn_in(frame, ["Rubiks-1-5 trial 1", "move 3/5: F' (twist)", "t =  12.34 s"])
+    out = burn_in(frame, ["Rubiks-1-5 trial 1", "move 3/5: F' (twist)", "t = 12.34 s"])
     assert out.shape == frame.shape and out.dtype == np.uint8
     changed = np.any(out != frame, axis=2)
     ys, xs = np.nonzero(changed)
@@ -56,7 +56,7 @@ def _ctx(sequence: str):
 def test_overlay_follows_the_moves_and_the_clock():
     ctx, t = _ctx("R U F' D2 L")
     ov = _Overlay(ctx)
-    assert ov.lines() == ["Rubiks-1-5 trial 1", "move 1/5: R", "t =   0.00 s"]
+    assert ov.lines() == ["Rubiks-1-5 trial 1", "move 1/5: R", "t = 0.00 s"]
     ctx.recorder.event("action", action="Pick")
     t[0] = ctx.backend.time = 1.5
     ctx.recorder.contact()
@@ -67,7 +67,7 @@ def test_overlay_follows_the_moves_and_the_clock():
     ctx.backend.time = 3.25
     lines = ov.lines()
     assert lines[1] == "move 3/5: F' (twist)"
-    assert lines[2] == "t =   3.25 s   since first contact   1.75 s"
+    assert lines[2] == "t = 3.25 s, since contact 1.75 s"
     for i, m in enumerate(["F'", "D2", "L"], start=2):
         ctx.recorder.move(i, m)
     ctx.recorder.event("action", action="Release")
@@ -76,7 +76,7 @@ def test_overlay_follows_the_moves_and_the_clock():
 
 def test_views():
     close, wide = rubiks_camera((0.6, 0, 0.58), "close"), rubiks_camera((0.6, 0, 0.58), "wide")
-    assert (close.width, close.height) == VIDEO_SIZE == (480, 360)
+    assert (close.width, close.height) == VIDEO_SIZE == (400, 300)
     d_close = np.linalg.norm(np.subtract(close.eye, close.target))
     d_wide = np.linalg.norm(np.subtract(wide.eye, wide.target))
     # the 5.7 cm cube at the target spans more than a fifth of the close view's height
@@ -122,7 +122,7 @@ def test_filming_changes_no_result_and_is_deterministic(invoke, tmp_path):
         for key in ("status", "score", "failure_cause", "sim_s", "first_contact_s"):
             assert rec[key] == plain[key], key
     (_, a), (_, b) = filmed
-    assert len(a) == len(b) >= 3 and all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert len(a) == len(b) >= 2 and all(np.array_equal(x, y) for x, y in zip(a, b))
     assert a[0].shape == (120, 160, 3)
     assert not np.array_equal(a[0], a[-1])  # the clock runs (and the box falls)
 

@@ -395,7 +395,7 @@ def _summary(spec, store, benchmark: str, total: int, selected: Sequence[int]):
 @click.option(
     "--video-fps",
     type=float,
-    default=10.0,
+    default=8.0,
     show_default=True,
     help="Frames per *simulated* second.",
 )
@@ -408,7 +408,7 @@ def _summary(spec, store, benchmark: str, total: int, selected: Sequence[int]):
 )
 @click.option(
     "--video-size",
-    default="480x360",
+    default="400x300",
     show_default=True,
     help="Frame size WIDTHxHEIGHT.",
 )

@@ -8,10 +8,10 @@ Rendering happens only at frame times, from the runner's step callback; the
 physics never waits on anything else, so a result is the same with or
 without a video.
 
-Defaults (:data:`VIDEO_SIZE`, :data:`DEFAULT_FPS`): 480 x 360 at 10 frames
+Defaults (:data:`VIDEO_SIZE`, :data:`DEFAULT_FPS`): 400 x 300 at 8 frames
 per simulated second, which keeps recording under the trial's own CPU time
 with PyBullet's CPU renderer, whose cost grows with the pixels drawn
-(640 x 480 costs about twice as much: BENCHMARKS.md, "Trial video"). The camera is
+(480 x 360 costs ~1.5x, 640 x 480 ~2.5x as much: BENCHMARKS.md, "Trial video"). The camera is
 a *view* (:data:`VIEWS`): ``close`` frames both hands and the cube (a
 Rubik's strategy's :meth:`video_camera`, else the workspace in front of the
 robot; in-hand: the hand), ``wide`` the whole robot. Each frame carries the
@@ -55,8 +55,8 @@ __all__ = [
 ]
 
 #: Frame size (width, height) and rate (frames per simulated second) unless asked otherwise.
-VIDEO_SIZE = (480, 360)
-DEFAULT_FPS = 10.0
+VIDEO_SIZE = (400, 300)
+DEFAULT_FPS = 8.0
 #: Camera views ``run --video-view`` offers.
 VIEWS = ("close", "wide")
 
@@ -140,7 +140,7 @@ def rubiks_camera(
 
 
 def _inhand_camera(ctx: TrialContext, view: str, size: tuple[int, int]) -> CameraSpec | None:
-    """The hand's base link, seen from above in front: close 0.45 m away, wide 1.0 m."""
+    """The hand, seen from above in front: close 0.4 m away, wide 1.0 m."""
     body = getattr(ctx.robot, "body", None)
     if body is None:
         return None
@@ -148,7 +148,7 @@ def _inhand_camera(ctx: TrialContext, view: str, size: tuple[int, int]) -> Camer
         base = ctx.backend.get_link_pose(body, None).p
     except Exception:  # noqa: BLE001 - not spawned (yet): the caller falls back
         return None
-    dist = 0.45 if view == "close" else 1.0
+    dist = 0.4 if view == "close" else 1.0
     d = np.array([0.75, -0.45, 0.55])
     eye = base + dist * d / np.linalg.norm(d)
     return CameraSpec(
@@ -196,7 +196,7 @@ def _font(px: int) -> Any:
 def burn_in(frame: np.ndarray, lines: Sequence[str]) -> np.ndarray:
     """``frame`` with ``lines`` of text in a dark box in its top-left corner (white on black).
 
-    The text is 1/24 of the frame's height (15 px at 360), so it stays
+    The text is 1/20 of the frame's height (15 px at 300), so it stays
     readable after the MP4's compression; the box covers only the text.
     """
     if not lines:
@@ -205,7 +205,7 @@ def burn_in(frame: np.ndarray, lines: Sequence[str]) -> np.ndarray:
 
     img = Image.fromarray(np.ascontiguousarray(frame[..., :3], dtype=np.uint8))
     draw = ImageDraw.Draw(img)
-    px = max(10, img.height // 24)
+    px = max(12, img.height // 20)
     font = _font(px)
     pad, gap = px // 2, px // 4
     widths = [draw.textlength(s, font=font) for s in lines]
@@ -242,9 +242,9 @@ class _Overlay:
                 self._action = str(e.get("action", "")).lower()
         self._seen = len(events)
         t = float(self.ctx.backend.time) - self.ctx.sim_start
-        clock = f"t = {t:6.2f} s"
+        clock = f"t = {t:.2f} s"
         if rec.first_contact_s is not None:
-            clock += f"   since first contact {t + self.ctx.sim_start - rec.first_contact_s:6.2f} s"
+            clock += f", since contact {t + self.ctx.sim_start - rec.first_contact_s:.2f} s"
         out = [self.title]
         if self.sequence is not None:
             n = len(self.sequence)
@@ -297,7 +297,7 @@ class VideoWriter:
                     quality=7,
                     ffmpeg_log_level="error",
                     # the encoder's own threads would compete with the physics for the CPU
-                    output_params=["-preset", "veryfast", "-threads", "1"],
+                    output_params=["-preset", "ultrafast", "-threads", "1"],
                 )
                 self._gen.send(None)
             else:
