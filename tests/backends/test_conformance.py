@@ -602,6 +602,92 @@ def test_capabilities(backend: Backend, item):
             backend.render(cam)
 
 
+GREEN = (0.1, 0.9, 0.1, 1.0)
+BLUE = (0.1, 0.2, 0.95, 1.0)
+RED = (0.95, 0.1, 0.1, 1.0)
+TOP_CAM = CameraSpec(eye=(0.0, -0.15, 0.6), target=(0, 0, 0.05), width=96, height=72, fov_deg=40)
+
+
+def _pixels_like(img: np.ndarray, rgba: tuple[float, ...]) -> int:
+    """Pixels whose hue is the colour's (lit or shaded): the colour direction, any brightness."""
+    c = np.asarray(rgba[:3]) / np.linalg.norm(rgba[:3])
+    px = img.reshape(-1, 3).astype(float)
+    n = np.linalg.norm(px, axis=1)
+    lit = n > 40
+    return int(np.sum(lit & (px @ c > 0.97 * np.where(lit, n, 1.0))))
+
+
+def _visual_scene(b: Backend, with_visuals: bool) -> int:
+    b.add_ground()
+    plate = Box((0.08, 0.02, 0.004), Pose([0, 0, 0.06]), rgba=GREEN)  # a strip overhanging in x
+    return b.add_body(
+        [Box((0.05, 0.05, 0.05), rgba=RED)],
+        Pose([0, 0, 0.06], Rotation.from_euler("xy", [0.2, 0.1]).as_quat()),
+        1.0,
+        visuals=[plate] if with_visuals else (),
+    )
+
+
+def test_visual_shapes_are_render_only(make):
+    """``add_body(visuals=...)`` changes nothing physical: mass, fall, contacts, rays are as without."""
+    a, b = make(), make()
+    ba, bb = _visual_scene(a, True), _visual_scene(b, False)
+    assert a.get_mass(ba) == pytest.approx(1.0)
+    a.step(120)
+    b.step(120)
+    pa, pb_ = a.get_pose(ba), b.get_pose(bb)
+    np.testing.assert_array_equal(pa.p, pb_.p)
+    np.testing.assert_array_equal(pa.q, pb_.q)
+    # a ray past the box's side, through the overhanging plate, reaches the ground
+    hits = a.ray_cast(np.array([[0.07, 0.0, 0.3]]), np.array([[0.0, 0.0, -1.0]]), 1.0)
+    assert hits.body[0] != ba
+    if a.capabilities.camera:
+        img = a.render(TOP_CAM)
+        assert _pixels_like(img, GREEN) > 100 and _pixels_like(img, RED) > 100  # strip and box
+        plain = b.render(TOP_CAM)
+        assert _pixels_like(plain, GREEN) == 0 and _pixels_like(plain, RED) > 200
+    a.close()
+    b.close()
+
+
+def test_urdf_visual_colours_are_render_only(backend: Backend, tmp_path: Path):
+    """A URDF link's ``<visual>`` with a material colour is drawn where there is a camera, never hit."""
+    urdf = tmp_path / "painted.urdf"
+    urdf.write_text(
+        """<?xml version="1.0"?>
+<robot name="painted">
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><box size="0.1 0.1 0.1"/></geometry>
+      <material name="blue"><color rgba="0.1 0.2 0.95 1"/></material></visual>
+    <visual><origin xyz="0 0 0.06"/><geometry><box size="0.16 0.16 0.008"/></geometry>
+      <material name="green"><color rgba="0.1 0.9 0.1 1"/></material></visual>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+  </link>
+  <link name="stub">
+    <inertial><mass value="0.1"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="-0.3 0 0"/><geometry><sphere radius="0.01"/></geometry></collision>
+  </link>
+  <joint name="hinge" type="revolute">
+    <parent link="base"/><child link="stub"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>
+""",
+        encoding="utf-8",
+    )
+    body = backend.load_urdf(urdf, Pose([0, 0, 0.05]))
+    backend.step(1)  # PhysX's scene query sees a new pose after a step
+    assert backend.get_mass(body) == pytest.approx(1.1)
+    hits = backend.ray_cast(np.array([[0.07, 0.0, 0.3]]), np.array([[0.0, 0.0, -1.0]]), 1.0)
+    assert not hits.hit[0]
+    hits = backend.ray_cast(np.array([[0.0, 0.0, 0.3]]), np.array([[0.0, 0.0, -1.0]]), 1.0)
+    assert hits.body[0] == body and hits.distance[0] == pytest.approx(0.2, abs=1e-4)
+    if backend.capabilities.camera:
+        img = backend.render(TOP_CAM)
+        assert _pixels_like(img, GREEN) > 200
+
+
 def test_worlds_are_independent(make):
     a, b = make(), make(gravity=(0.0, 0.0, 0.0))
     ba = a.add_body([Sphere(0.05)], Pose([0, 0, 1.0]), 1.0)

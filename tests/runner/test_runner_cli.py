@@ -118,10 +118,16 @@ def test_video_mp4_and_a_clear_error_without_a_camera(invoke, tmp_path):
         run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--video", str(mp4), "--json"
     )
     assert r.exit_code == 0, r.output
-    info = _json(r)["video"]
-    # the trial lasts ~0.3 simulated s: frames at 30 per simulated second
-    assert 5 <= info["frames"] <= 15 and mp4.stat().st_size > 1000
+    data = _json(r)
+    info, sim_s = data["video"], data["trials"][0]["sim_s"]
+    # frame k shows the world once k / fps simulated seconds have passed: ceil(duration x fps)
+    assert info["fps"] == 8 and info["view"] == "close" and info["size"] == [400, 300]
+    assert info["frames"] == math.ceil(sim_s * 8 - 1e-6) >= 2
     assert mp4.read_bytes()[4:8] == b"ftyp"
+    import imageio_ffmpeg
+
+    n, secs = imageio_ffmpeg.count_frames_and_secs(str(mp4))  # decoded by ffmpeg: a valid MP4
+    assert n == info["frames"] and secs == pytest.approx(n / 8, abs=0.05)
     r = invoke(
         run,
         "--task",

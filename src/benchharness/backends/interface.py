@@ -43,6 +43,7 @@ __all__ = [
     "MeshShape",
     "PhysicsConfig",
     "RayHits",
+    "Rgba",
     "Shape",
     "SimulationError",
     "Sphere",
@@ -148,16 +149,23 @@ class PhysicsConfig:
             raise ValueError(f"seed={self.seed!r}: must be an integer >= 0")
 
 
+#: A render colour: red, green, blue, alpha in 0..1.
+Rgba = tuple[float, float, float, float]
+
+
 @dataclass(frozen=True)
 class Box:
     half_extents: tuple[float, float, float]
     pose: Pose = field(default_factory=Pose)  #: shape pose in the body frame
+    #: colour in rendered images (``None``: the backend's default grey); physics ignores it
+    rgba: Rgba | None = None
 
 
 @dataclass(frozen=True)
 class Sphere:
     radius: float
     pose: Pose = field(default_factory=Pose)
+    rgba: Rgba | None = None  #: as :attr:`Box.rgba`
 
 
 @dataclass(frozen=True)
@@ -167,6 +175,7 @@ class Cylinder:
     radius: float
     half_length: float
     pose: Pose = field(default_factory=Pose)
+    rgba: Rgba | None = None  #: as :attr:`Box.rgba`
 
 
 @dataclass(frozen=True)
@@ -176,6 +185,7 @@ class MeshShape:
     vertices: np.ndarray
     faces: np.ndarray
     pose: Pose = field(default_factory=Pose)
+    rgba: Rgba | None = None  #: as :attr:`Box.rgba`
 
 
 Shape = Box | Sphere | Cylinder | MeshShape
@@ -348,11 +358,18 @@ class Backend(abc.ABC):
         name: str | None = None,
         com: Sequence[float] | None = None,
         inertia_diag: Sequence[float] | None = None,
+        visuals: Sequence[Shape] = (),
     ) -> BodyId:
         """A rigid body made of one or more primitive shapes.
 
         Mass is spread uniformly by volume unless ``com`` / ``inertia_diag``
         (principal moments about the COM, in the body frame) are given.
+
+        ``visuals`` are render-only shapes moving with the body (e.g. a
+        Rubik's cube's stickers): they have no mass, never collide and rays
+        pass through them; a backend with a camera draws them (and each
+        shape, collision or visual, in its ``rgba``), one without ignores
+        them. The physics of a body is the same with or without them.
         """
 
     @abc.abstractmethod
@@ -364,7 +381,14 @@ class Backend(abc.ABC):
         fixed_base: bool = True,
         name: str | None = None,
     ) -> BodyId:
-        """An articulated body from a collision-only URDF (``<visual>`` is ignored)."""
+        """An articulated body from a URDF: its ``<collision>`` elements are the physics.
+
+        ``<visual>`` elements (primitive geometry with an inline
+        ``<material><color rgba=.../></material>``) are render-only, as
+        :meth:`add_body`'s ``visuals``: a backend with a camera draws them,
+        one without ignores them; a link without ``<visual>`` is drawn as its
+        collision geometry.
+        """
 
     @abc.abstractmethod
     def remove_body(self, body: BodyId) -> None:

@@ -50,6 +50,37 @@ from .interface import (
     StepCallback,
 )
 
+#: the colour of a shape drawn without an ``rgba``, and of a URDF link without a ``<visual>`` colour
+_GREY = (0.45, 0.5, 0.6, 1.0)
+_URDF_GREY = (0.45, 0.47, 0.52, 1.0)
+
+
+def _rgb8(rgba: Sequence[float] | None) -> tuple[int, int, int]:
+    r, g, b = (int(round(255 * min(max(float(x), 0.0), 1.0))) for x in (rgba or _GREY)[:3])
+    return r, g, b
+
+
+def _triangles(s: Shape) -> tuple[np.ndarray, np.ndarray]:
+    """A shape's surface in the body frame: triangles (n, 3, 3) and their unit normals (n, 3)."""
+    import trimesh
+
+    if isinstance(s, Box):
+        m = trimesh.creation.box(extents=2.0 * np.asarray(s.half_extents, dtype=float))
+    elif isinstance(s, Sphere):
+        m = trimesh.creation.icosphere(subdivisions=2, radius=float(s.radius))
+    elif isinstance(s, Cylinder):
+        m = trimesh.creation.cylinder(
+            radius=float(s.radius), height=2.0 * float(s.half_length), sections=24
+        )
+    elif isinstance(s, MeshShape):
+        m = trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+    else:
+        raise BackendError(f"unknown shape {type(s).__name__}")
+    rot = s.pose.rotation.as_matrix()
+    tri = np.asarray(m.vertices, dtype=float)[np.asarray(m.faces)] @ rot.T + s.pose.p
+    return tri, np.asarray(m.face_normals, dtype=float) @ rot.T
+
+
 #: a base speed above this (m/s or rad/s) counts as a blow-up, as does a non-finite state
 MAX_SPEED = 1.0e4
 _RAY_BATCH = 16000
@@ -118,6 +149,7 @@ class PyBulletBackend(Backend):
         self._step_lists: tuple[list[_Body], list[tuple[int, int]]] | None = None
         self._closed = False
         self._grounds: dict[int, float] = {}
+        self._palettes: dict[tuple[tuple[int, int, int], ...], int] = {}  #: colours -> texture id
         self._gravity = np.asarray(c.gravity, dtype=float)
 
     # -- lifetime --------------------------------------------------------------
@@ -374,10 +406,14 @@ class PyBulletBackend(Backend):
     def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
         cid = self._cid
         shape = pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=[0, 0, 1], physicsClientId=cid)
+        # Not drawn: filling most of a frame, a floor doubled TinyRenderer's time per 640 x 480
+        # image (measured 150 vs 60 ms, PR2 scene; BENCHMARKS.md, "Trial video"), and the
+        # renderer's light grey background reads as the floor anyway. Without a visual shape
+        # PyBullet would draw the plane as a checkerboard, so it gets a 1 mm box 1 m below.
         vis = pb.createVisualShape(
             pb.GEOM_BOX,
-            halfExtents=[5, 5, 0.0005],
-            visualFramePosition=[0, 0, -0.0005],
+            halfExtents=[0.0005] * 3,
+            visualFramePosition=[0, 0, -1.0],
             rgbaColor=[0.8, 0.8, 0.8, 1],
             physicsClientId=cid,
         )
@@ -429,9 +465,12 @@ class PyBulletBackend(Backend):
         name: str | None = None,
         com: Sequence[float] | None = None,
         inertia_diag: Sequence[float] | None = None,
+        visuals: Sequence[Shape] = (),
     ) -> BodyId:
         cid = self._cid
         shapes = list(shapes)
+        visuals = list(visuals)
+        coloured = bool(visuals) or any(s.rgba is not None for s in shapes)
         mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         tmp: list[str] = []
         arrays = self._shape_arrays(shapes, tmp)  # mesh hulls are written to disk once, here
@@ -439,7 +478,11 @@ class PyBulletBackend(Backend):
             col = pb.createCollisionShape(**self._shape_args(shapes[0], tmp), physicsClientId=cid)
         else:  # one single-link multibody; several shapes become one compound collision shape
             col = self._compound(arrays)
-        vis = self._visuals(arrays)
+        texture = -1
+        if coloured:  # one textured mesh: createVisualShapeArray draws at most 16 shapes
+            vis, texture = self._coloured_visual(shapes + visuals)
+        else:
+            vis = self._visuals(arrays)
         m = 0.0 if fixed else float(mass)
         uid = pb.createMultiBody(
             baseMass=m,
@@ -466,8 +509,12 @@ class PyBulletBackend(Backend):
         if not fixed:
             kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
         pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
-        if vis >= 0:
-            pb.changeVisualShape(uid, -1, rgbaColor=[0.45, 0.5, 0.6, 1], physicsClientId=cid)
+        if vis >= 0 and texture >= 0:
+            pb.changeVisualShape(
+                uid, -1, textureUniqueId=texture, rgbaColor=[1, 1, 1, 1], physicsClientId=cid
+            )
+        elif vis >= 0:
+            pb.changeVisualShape(uid, -1, rgbaColor=list(_GREY), physicsClientId=cid)
         return self._register(
             _Body(
                 uid=uid,
@@ -550,6 +597,54 @@ class PyBulletBackend(Backend):
             )
         except pb.error:  # rendering is a nicety; physics does not need it
             return -1
+
+    def _coloured_visual(self, shapes: list[Shape]) -> tuple[int, int]:
+        """All of a body's drawn shapes as one triangle mesh, coloured through a palette texture.
+
+        PyBullet gives a vertex no colour and a link at most 16 visual shapes
+        (a stickered cube has 55), so every triangle's three UVs point at the
+        centre of its colour's 4 x 4 texel block in a small palette image
+        (one per set of colours, loaded once per world). Alpha is not drawn.
+        Returns ``(visual shape id, texture id)``, ``(-1, -1)`` if PyBullet refuses.
+        """
+        parts = [(_triangles(s), _rgb8(s.rgba)) for s in shapes]
+        colours = tuple(sorted({c for _, c in parts}))
+        slot = {c: i for i, c in enumerate(colours)}
+        verts, normals, uvs = [], [], []
+        for (tri, nrm), c in parts:
+            verts.append(tri.reshape(-1, 3))
+            normals.append(np.repeat(nrm, 3, axis=0))
+            uv = np.array([(slot[c] + 0.5) / len(colours), 0.5])
+            uvs.append(np.tile(uv, (3 * len(tri), 1)))
+        v = np.concatenate(verts)
+        try:
+            vis = pb.createVisualShape(
+                pb.GEOM_MESH,
+                vertices=v.tolist(),
+                indices=list(range(len(v))),
+                uvs=np.concatenate(uvs).tolist(),
+                normals=np.concatenate(normals).tolist(),
+                physicsClientId=self._cid,
+            )
+            return vis, self._palette(colours)
+        except pb.error:  # rendering is a nicety; physics does not need it
+            return -1, -1
+
+    def _palette(self, colours: tuple[tuple[int, int, int], ...]) -> int:
+        tex = self._palettes.get(colours)
+        if tex is None:
+            img = np.repeat(np.repeat(np.array([colours], dtype=np.uint8), 4, axis=0), 4, axis=1)
+            from PIL import Image  # Pillow comes with matplotlib, a dependency
+
+            fd, fn = tempfile.mkstemp(suffix=".png", prefix="bh_palette_")
+            os.close(fd)
+            try:
+                Image.fromarray(img).save(fn)
+                tex = int(pb.loadTexture(fn, physicsClientId=self._cid))
+            finally:
+                os.unlink(fn)
+            self._palettes[colours] = tex
+        return tex
 
     @staticmethod
     def _hull_obj(s: MeshShape, tmp: list[str]) -> str:
@@ -643,6 +738,15 @@ class PyBulletBackend(Backend):
         )
         h = self._register(b)
         self.set_pose(h, base_pose)
+        # links drawn from their collision geometry (no <visual>) come out white: grey them, so
+        # a robot stands out from the background; a URDF's own (non-white) colours stay
+        white = {
+            int(v[1])
+            for v in pb.getVisualShapeData(uid, physicsClientId=cid)
+            if tuple(v[7]) == (1.0, 1.0, 1.0, 1.0)
+        }
+        for link in sorted(white):
+            pb.changeVisualShape(uid, link, rgbaColor=list(_URDF_GREY), physicsClientId=cid)
         return h
 
     def remove_body(self, body: BodyId) -> None:
@@ -947,6 +1051,7 @@ class PyBulletBackend(Backend):
             view,
             proj,
             renderer=pb.ER_TINY_RENDERER,
+            flags=pb.ER_NO_SEGMENTATION_MASK,  # only the colours are returned
             physicsClientId=self._cid,
         )
         img = np.asarray(rgba, dtype=np.uint8).reshape(camera.height, camera.width, 4)

@@ -263,7 +263,9 @@ class SapienBackend(Backend):
         name: str | None = None,
         com: Sequence[float] | None = None,
         inertia_diag: Sequence[float] | None = None,
+        visuals: Sequence[Shape] = (),
     ) -> BodyId:
+        del visuals  # render-only, and this backend has no renderer (module docstring)
         self._apply_global_config()
         shapes = list(shapes)
         mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)

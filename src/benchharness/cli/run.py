@@ -395,9 +395,22 @@ def _summary(spec, store, benchmark: str, total: int, selected: Sequence[int]):
 @click.option(
     "--video-fps",
     type=float,
-    default=30.0,
+    default=8.0,
     show_default=True,
     help="Frames per *simulated* second.",
+)
+@click.option(
+    "--video-view",
+    type=click.Choice(["close", "wide"]),
+    default="close",
+    show_default=True,
+    help="close: both hands and the cube (in-hand: the hand); wide: the whole robot.",
+)
+@click.option(
+    "--video-size",
+    default="400x300",
+    show_default=True,
+    help="Frame size WIDTHxHEIGHT.",
 )
 def run(
     task,
@@ -420,6 +433,8 @@ def run(
     video_path,
     video_trial,
     video_fps,
+    video_view,
+    video_size,
 ) -> None:
     """Run a task's trials with a robot, strategy, sensors and backend; store each as it ends.
 
@@ -467,7 +482,13 @@ def run(
             check_video_trial(video_trial, trial_sel)
             if not (video_fps > 0 and video_fps != float("inf")):
                 raise ValueError(f"--video-fps {video_fps}: must be a positive finite number")
-            video = VideoSpec(video_path, video_trial, video_fps)
+            try:
+                w, h = (int(v) for v in video_size.lower().split("x"))
+            except ValueError:
+                raise ValueError(
+                    f"--video-size {video_size!r}: WIDTHxHEIGHT, e.g. 640x480"
+                ) from None
+            video = VideoSpec(video_path, video_trial, video_fps, view=video_view, size=(w, h))
         except ValueError as exc:
             fail(str(exc))
     with _open_store(store_path) as store:
@@ -530,7 +551,8 @@ def run(
                 )
             if video_info:
                 console.print(
-                    f"video: {video_info['path']} ({video_info['frames']} frames at {video_info['fps']:g} fps)"
+                    f"video: {video_info['path']} ({video_info['frames']} frames at {video_info['fps']:g} fps, "
+                    f"{video_info.get('view', '')} view, {video_info.get('render_cpu_s', 0):.1f} s CPU rendering)"
                     + (f" — {video_info['note']}" if video_info.get("note") else "")
                 )
         if failed:

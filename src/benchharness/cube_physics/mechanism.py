@@ -45,10 +45,12 @@ from .model import (
     FACE_BODY_AXES,
     FACELET_BODY_POSITIONS,
     JOINT_NAMES,
+    PLASTIC_RGBA,
     axis_index,
     rigid_half_extents,
     rigid_inertia,
     slab_geometry,
+    stickers,
     write_articulated_urdf,
 )
 from .outcome import TwistBlockedError, TwistOutcome
@@ -255,9 +257,9 @@ class PhysicalCube:
         moves = ""
         if aligned:
             moves = layer_moves(axis, s0.quarter_turns, s2.quarter_turns)
-            self._snap_and_swap_to_rigid(axis, s0, s2)
-            if moves:
-                self._state = apply_moves(self._state, moves)
+            after = apply_moves(self._state, moves) if moves else self._state
+            self._snap_and_swap_to_rigid(axis, s0, s2, after)  # the rigid cube shows ``after``
+            self._state = after
         self._misaligned = not aligned
         outcome = self._outcome(axis, (a0, a2), (s0, s2), moves, aligned, before)
         self.history.append(outcome)
@@ -270,18 +272,33 @@ class PhysicalCube:
         self._axis = None
 
     # -- internals ------------------------------------------------------------------------
+    def _rendered(self) -> bool:
+        """Whether to give the bodies sticker visuals (only a backend with a camera draws them)."""
+        return bool(self.backend.capabilities.camera)
+
     def _spawn_rigid(
-        self, pose: Pose, lin: Sequence[float] | np.ndarray, ang: Sequence[float] | np.ndarray
+        self,
+        pose: Pose,
+        lin: Sequence[float] | np.ndarray,
+        ang: Sequence[float] | np.ndarray,
+        state: np.ndarray | None = None,
     ) -> BodyId:
         c = self.config
+        shown = self._state if state is None else state
+        visuals = (
+            [Box(st.half_extents, Pose(st.centre), rgba=st.rgba) for st in stickers(c, shown)]
+            if self._rendered()
+            else []
+        )
         body = self.backend.add_body(
-            [Box(rigid_half_extents(c))],
+            [Box(rigid_half_extents(c), rgba=PLASTIC_RGBA if visuals else None)],
             pose,
             c.mass,
             friction=c.surface_friction,
             name=self.name,
             com=(0.0, 0.0, 0.0),
             inertia_diag=tuple(rigid_inertia(c)),
+            visuals=visuals,
         )
         self.backend.set_velocity(body, lin, ang)
         return body
@@ -290,7 +307,9 @@ class PhysicalCube:
         b = self.backend
         pose = b.get_pose(self._body)
         lin, ang = b.get_velocity(self._body)
-        path = write_articulated_urdf(self.config, axis)
+        path = write_articulated_urdf(
+            self.config, axis, state=self._state if self._rendered() else None
+        )
         try:
             b.remove_body(self._body)
             self._body = b.load_urdf(path, pose, fixed_base=False, name=self.name)
@@ -342,7 +361,9 @@ class PhysicalCube:
             force_limit=cap.tolist(),
         )
 
-    def _snap_and_swap_to_rigid(self, axis: str, s0: SnappedAngle, s2: SnappedAngle) -> None:
+    def _snap_and_swap_to_rigid(
+        self, axis: str, s0: SnappedAngle, s2: SnappedAngle, state: np.ndarray
+    ) -> None:
         b = self.backend
         # Turn the whole set by the mean residual so no slab jumps more than needed:
         # the three slabs sit at 0, a0, a2 and end at phi, phi + 90 k0, phi + 90 k2.
@@ -360,7 +381,7 @@ class PhysicalCube:
         b.set_pose(self._body, snapped)
         self._stop_updates()
         b.remove_body(self._body)
-        self._body = self._spawn_rigid(snapped, lin, ang)
+        self._body = self._spawn_rigid(snapped, lin, ang, state)
         self._axis = None
         self._gains = None
 

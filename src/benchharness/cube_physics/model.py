@@ -40,13 +40,17 @@ __all__ = [
     "FACELET_BODY_NORMALS",
     "FACELET_BODY_POSITIONS",
     "JOINT_NAMES",
+    "PLASTIC_RGBA",
     "SLAB_LINKS",
+    "STICKER_RGBA",
     "SlabGeometry",
+    "Sticker",
     "articulated_urdf",
     "axis_index",
     "rigid_half_extents",
     "rigid_inertia",
     "slab_geometry",
+    "stickers",
     "write_articulated_urdf",
 ]
 
@@ -88,6 +92,64 @@ def _facelet_geometry() -> tuple[np.ndarray, np.ndarray]:
 
 #: Facelet centres in the body frame for a unit edge (multiply by ``edge``), shape (54, 3).
 FACELET_BODY_POSITIONS, FACELET_BODY_NORMALS = _facelet_geometry()
+
+
+#: Sticker colours by colour code (the face letter of the centre it matches, ``FACES`` order
+#: URFDLB), the usual scheme: U white, R red, F green, D yellow, L orange, B blue.
+STICKER_RGBA: dict[str, tuple[float, float, float, float]] = {
+    "U": (0.95, 0.95, 0.95, 1.0),
+    "R": (0.80, 0.04, 0.04, 1.0),
+    "F": (0.00, 0.62, 0.22, 1.0),
+    "D": (1.00, 0.84, 0.00, 1.0),
+    "L": (1.00, 0.42, 0.00, 1.0),
+    "B": (0.00, 0.27, 0.80, 1.0),
+}
+#: The cubies' black plastic between the stickers.
+PLASTIC_RGBA = (0.04, 0.04, 0.04, 1.0)
+#: A sticker covers this fraction of its facelet's side; 0.6 mm thick, its inner face on the surface.
+STICKER_FILL = 0.86
+STICKER_THICKNESS = 0.0006
+
+
+@dataclass(frozen=True)
+class Sticker:
+    """One facelet's sticker, a thin box for rendering only (never part of the physics)."""
+
+    facelet: int  #: 0..53, position in the state string
+    slab: int  #: the slab it rides on for a twist about the axis asked (1 = middle / rigid)
+    centre: np.ndarray  #: (3,) in the body frame, or the slab's frame when a slab was asked
+    half_extents: tuple[float, float, float]
+    rgba: tuple[float, float, float, float]
+
+
+def stickers(config: CubeConfig, state: np.ndarray, axis: str | None = None) -> list[Sticker]:
+    """The 54 stickers of ``state`` (colour codes, ``FACES`` order), in the body frame.
+
+    With ``axis``, each sticker says which slab of a twist about ``axis``
+    carries it and is placed in that slab's frame (the frame the URDF's slab
+    link has), so the stickers turn with the layer they are on.
+    """
+    from ..cube.facelets import FACES
+
+    edge = config.edge
+    side = STICKER_FILL * edge / 3.0 / 2.0
+    a = None if axis is None else axis_index(axis)
+    out = []
+    for i in range(54):
+        n = FACELET_BODY_NORMALS[i]
+        k = int(np.argmax(np.abs(n)))
+        half = [side, side, side]
+        half[k] = STICKER_THICKNESS / 2.0
+        centre = FACELET_BODY_POSITIONS[i] * edge + n * (STICKER_THICKNESS / 2.0)
+        slab = 1
+        if a is not None:
+            c = FACELET_BODY_POSITIONS[i][a]  # -1/2, -1/3, 0, 1/3 or 1/2 of the edge
+            slab = 1 if abs(c) < 1.0 / 6.0 else (0 if c < 0 else 2)
+            centre = centre.copy()
+            centre[a] -= (slab - 1) * config.slab_thickness
+        h = (half[0], half[1], half[2])
+        out.append(Sticker(i, slab, centre, h, STICKER_RGBA[FACES[int(state[i])]]))
+    return out
 
 
 def axis_index(axis: str) -> int:
@@ -146,7 +208,7 @@ def _fmt(v: np.ndarray | tuple[float, ...]) -> str:
     return " ".join(f"{float(x):.9g}" for x in v)
 
 
-def articulated_urdf(config: CubeConfig, axis: str) -> str:
+def articulated_urdf(config: CubeConfig, axis: str, state: np.ndarray | None = None) -> str:
     """A collision-only URDF of the three-slab cube for a twist about ``axis``.
 
     The middle slab is the root (its link frame is the cube's centre, axes the
@@ -157,9 +219,28 @@ def articulated_urdf(config: CubeConfig, axis: str) -> str:
     friction and the detent are not in the URDF (engines read URDF dynamics
     differently); :class:`~benchharness.cube_physics.mechanism.PhysicalCube`
     sets them through the Backend interface.
+
+    With ``state`` (the 54 colour codes), each slab also gets ``<visual>``
+    elements for a renderer: its black plastic and the stickers it carries
+    (:func:`stickers`); engines without a renderer ignore them.
     """
     a = axis_index(axis)
     slabs = slab_geometry(config, axis)
+    visuals: dict[int, list[str]] = {0: [], 1: [], 2: []}
+    if state is not None:
+
+        def visual(centre: np.ndarray, size: np.ndarray, rgba: tuple[float, ...]) -> str:
+            return (
+                f'    <visual><origin xyz="{_fmt(centre)}" rpy="0 0 0"/>'
+                f'<geometry><box size="{_fmt(size)}"/></geometry>'
+                f'<material name="rgba_{_fmt(rgba).replace(" ", "_")}">'
+                f'<color rgba="{_fmt(rgba)}"/></material></visual>'
+            )
+
+        for s in slabs:
+            visuals[s.index].append(visual(np.zeros(3), s.size, PLASTIC_RGBA))
+        for st in stickers(config, state, axis):
+            visuals[st.slab].append(visual(st.centre, 2.0 * np.asarray(st.half_extents), st.rgba))
     axis_vec = np.zeros(3)
     axis_vec[a] = 1.0
     lines = ['<?xml version="1.0"?>', f'<robot name="rubiks_cube_axis_{axis}">']
@@ -172,6 +253,7 @@ def articulated_urdf(config: CubeConfig, axis: str) -> str:
             f'      <mass value="{s.mass:.9g}"/>',
             f'      <inertia ixx="{ixx:.9g}" ixy="0" ixz="0" iyy="{iyy:.9g}" iyz="0" izz="{izz:.9g}"/>',
             "    </inertial>",
+            *visuals[s.index],
             "    <collision>",
             '      <origin xyz="0 0 0" rpy="0 0 0"/>',
             f'      <geometry><box size="{_fmt(s.size)}"/></geometry>',
@@ -195,10 +277,13 @@ def articulated_urdf(config: CubeConfig, axis: str) -> str:
 
 
 def write_articulated_urdf(
-    config: CubeConfig, axis: str, directory: str | Path | None = None
+    config: CubeConfig,
+    axis: str,
+    directory: str | Path | None = None,
+    state: np.ndarray | None = None,
 ) -> Path:
     """Write :func:`articulated_urdf` to a new file (the caller deletes it)."""
     fd, name = tempfile.mkstemp(suffix=".urdf", prefix=f"bh_cube_{axis}_", dir=directory)
     with os.fdopen(fd, "w", encoding="utf-8") as fh:
-        fh.write(articulated_urdf(config, axis))
+        fh.write(articulated_urdf(config, axis, state))
     return Path(name)

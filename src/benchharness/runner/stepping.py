@@ -14,9 +14,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
 
-from ..backends.interface import CameraSpec
 from .contract import TrialContext, TrialTimeout
-from .video import VideoWriter
+from .video import TrialFilm
 
 __all__ = ["StepHooks", "wall_alarm"]
 
@@ -30,19 +29,10 @@ class StepHooks:
     spent budget raises :class:`TrialTimeout` out of ``backend.step``).
     """
 
-    def __init__(
-        self,
-        ctx: TrialContext,
-        video: VideoWriter | None = None,
-        camera: CameraSpec | None = None,
-        fps: float = 30.0,
-    ) -> None:
-        if video is not None and camera is None:
-            raise ValueError("a video needs a camera")
+    def __init__(self, ctx: TrialContext, film: TrialFilm | None = None) -> None:
         self.ctx = ctx
         self.backend = ctx.backend
-        self.video, self.camera, self.fps = video, camera, fps
-        self._next_frame = ctx.sim_start
+        self.film = film
         self._handle: int | None = None
 
     def install(self) -> None:
@@ -61,11 +51,8 @@ class StepHooks:
                 if self.backend.contacts(a, b):
                     rec.contact()
                     break
-        if self.video is not None and self.camera is not None:
-            t = float(self.backend.time)
-            while t + 1e-9 >= self._next_frame:
-                self.video.write(self.backend.render(self.camera))
-                self._next_frame += 1.0 / self.fps
+        if self.film is not None:  # renders only when a frame is due (simulated time)
+            self.film.after_step()
         self.ctx.check_budget()
 
 

@@ -29,7 +29,7 @@ from .seeding import trial_streams
 from .spec import RunSpec
 from .stepping import StepHooks, wall_alarm
 from .tasks import TaskPlan, plan_task
-from .video import DEFAULT_CAMERA, VideoSpec, VideoWriter
+from .video import TrialFilm, VideoSpec
 
 __all__ = ["execute_trial", "plan_for", "check_strategy_supports"]
 
@@ -106,7 +106,7 @@ def execute_trial(
     backend = None
     ctx: TrialContext | None = None
     hooks: StepHooks | None = None
-    writer: VideoWriter | None = None
+    film: TrialFilm | None = None
     stage = "creating the backend"
     try:
         physics = replace(spec.physics, seed=streams.backend_seed)
@@ -135,9 +135,8 @@ def execute_trial(
             sim_start=float(backend.time),
         )
         if video is not None and video.trial_index == index:
-            camera = video.camera or getattr(strategy, "video_camera", None) or DEFAULT_CAMERA
-            writer = VideoWriter(video.path, video.fps, (camera.width, camera.height))
-            hooks = StepHooks(ctx, writer, camera, video.fps)
+            film = TrialFilm(video, ctx, strategy)
+            hooks = StepHooks(ctx, film)
         else:
             hooks = StepHooks(ctx)
         hooks.install()
@@ -170,13 +169,8 @@ def execute_trial(
         else:
             verdict = score_inhand(item, outcome)  # type: ignore[arg-type]
         diag = recorder.to_json()
-        if writer is not None and video is not None:
-            diag["video"] = {
-                "path": str(writer.path),
-                "frames": writer.frames_written,
-                "fps": video.fps,
-                "note": writer.note,
-            }
+        if film is not None:
+            diag["video"] = film.info()
         return TrialRecord(
             spec.run_key,
             index,
@@ -213,9 +207,9 @@ def execute_trial(
     finally:
         if hooks is not None:
             hooks.uninstall()
-        if writer is not None:
+        if film is not None:
             try:
-                writer.close()
+                film.close()
             except Exception:  # noqa: BLE001 - a failed encoder must not hide the trial's result
                 pass
         if backend is not None:

@@ -20,9 +20,10 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ...backends.interface import Box
+from ...backends.interface import Box, CameraSpec
 from ...geometry import Pose
 from ...runner.contract import TrialContext, TrialOutcome
+from ...runner.video import rubiks_camera
 from ..regrasp import (
     HandModel,
     Handover,
@@ -86,6 +87,14 @@ class DeadReckoningStrategy:
         self.config = config or PR2RubiksConfig()
 
     # ------------------------------------------------------------------ trial
+
+    def video_camera(self, view: str, size: tuple[int, int]) -> CameraSpec:
+        """The trial video's camera (``run --video-view``): ``close`` frames both hands at the
+        twisting pose above the table and the cube on it, ``wide`` the robot (runner/video.py)."""
+        cfg = self.config
+        x, y = cfg.cube_xy
+        return rubiks_camera((x, y, cfg.table_height + 0.08), view, size)
+
     def run_trial(self, ctx: TrialContext) -> TrialOutcome:
         from ...cube_physics import PhysicalCube
 
@@ -97,7 +106,7 @@ class DeadReckoningStrategy:
         h = cfg.table_height
         tx, ty = cfg.table_half_size
         b.add_body(
-            [Box((tx, ty, h / 2))],
+            [Box((tx, ty, h / 2), rgba=(0.55, 0.40, 0.26, 1.0))],  # wood, in a video
             Pose([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]),
             1.0,
             fixed=True,
