@@ -126,6 +126,8 @@ class SapienBackend(Backend):
         self._system = physx.PhysxCpuSystem()
         self._scene = sapien.Scene([self._system])
         self._scene.set_timestep(c.timestep)
+        #: the engine's own step (bench/bench_speed.py times this call to find the engine's floor)
+        self._engine_step: Any = self._system.step
         self._bodies: BodyTable[_Body] = BodyTable()
         self._entity_map: dict[int, tuple[int, str | None]] = {}  # per_scene_id -> (handle, link)
         self._constraints: dict[int, Any] = {}
@@ -166,6 +168,7 @@ class SapienBackend(Backend):
             pass
         self._scene = None
         self._system = None
+        self._engine_step = None
 
     # -- helpers ---------------------------------------------------------------
     def _b(self, body: BodyId) -> _Body:
@@ -211,7 +214,7 @@ class SapienBackend(Backend):
                 # bases that can move (a fixed base cannot; joints are checked after the loop)
                 self._roots = [(h, b.root) for h, b in self._bodies.items() if not b.fixed]
             roots = self._roots
-            self._scene.step()
+            self._engine_step()
             self._steps += 1
             for h, comp in roots:
                 lv = comp.linear_velocity
@@ -469,6 +472,13 @@ class SapienBackend(Backend):
         v = np.asarray(art.qvel, dtype=float)[b.perm]
         # PhysX does not report drive forces: evaluate the (capped) drive law at the current state
         return JointState(q, v, b.drive.efforts(q, v))
+
+    def get_joint_motion(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        b = self._b(body)
+        art = b.articulation
+        if art is None or not b.joints:
+            return np.zeros(0), np.zeros(0)
+        return np.asarray(art.qpos, dtype=float)[b.perm], np.asarray(art.qvel, dtype=float)[b.perm]
 
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None

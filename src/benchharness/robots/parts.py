@@ -371,6 +371,7 @@ class Gripper:
         self._link_cb: tuple[object, int] | None = (
             None  # (backend, step-callback handle) while moving
         )
+        self._link_plan: tuple | None = None  # see _aim_linkages
 
     @property
     def name(self) -> str:
@@ -424,12 +425,23 @@ class Gripper:
         be = self.robot.backend
         if not links or be is None or self.robot.body is None:
             return
-        leaders = [k.leader for k in links]
-        pos = self.robot.joint_positions(leaders)
-        vel = self.robot.joint_velocities(leaders)
-        t = np.array([k.target(float(p)) for k, p in zip(links, pos)])
-        v = np.array([k.rate(float(p)) * float(w) for k, p, w in zip(links, pos, vel)])
-        moving = bool(np.max(np.abs(vel)) > 1e-4)
+        # this runs after every physics step while a finger moves: names and gains are built once
+        plan = self._link_plan
+        if plan is None:
+            names = [k.follower for k in links]
+            plan = self._link_plan = (
+                tuple(k.leader for k in links),
+                names,
+                [k.stiffness for k in links],
+                [k.damping for k in links],
+                [self.robot.urdf_joints[n].effort for n in names],
+            )
+        leaders, names, stiffness, damping, force_limit = plan
+        pos, vel = self.robot.joint_motion(leaders)
+        pl = pos.tolist()
+        t = np.array([k.target(p) for k, p in zip(links, pl)])
+        v = np.array([k.rate(p) * w for k, p, w in zip(links, pl, vel.tolist())])
+        moving = bool(np.abs(vel).max() > 1e-4)
         if moving and (self._link_cb is None or self._link_cb[0] is not be):
             self._link_cb = (be, be.add_step_callback(self._aim_linkages))
         elif not moving and self._link_cb is not None:
@@ -443,15 +455,14 @@ class Gripper:
         ):
             return
         self._link_sent = None if moving else t
-        names = [k.follower for k in links]
         be.set_joint_targets(
             self.robot.body,
             t,
             v,
             joints=names,
-            stiffness=[k.stiffness for k in links],
-            damping=[k.damping for k in links],
-            force_limit=[self.robot.urdf_joints[n].effort for n in names],
+            stiffness=stiffness,
+            damping=damping,
+            force_limit=force_limit,
         )
 
     def update(self) -> None:
