@@ -78,6 +78,10 @@ class _Body(BodyRecord):
         None  #: world gravity in a fixed base's inertial frame (cached)
     )
     gravity_tilted: bool = False  #: gravity_base differs from world gravity (cached with it)
+    #: (step, q, v) last read from the engine: joints only change by stepping or a teleport
+    #: (set_joint_positions clears it), and the drive law and the controllers read them several
+    #: times a step (see _motion)
+    motion: tuple[int, np.ndarray, np.ndarray] | None = None
     driven_pb: list[int] = field(default_factory=list)
     ones: list[float] = field(default_factory=list)  #: velocity gains (1.0) for driven_pb
     drive_cache: tuple | None = (
@@ -315,15 +319,12 @@ class PyBulletBackend(Backend):
         """
         dt = self.config.timestep
         sel = b.driven_idx
-        states = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
-        q = np.array([s[0] for s in states])
+        q, v = self._motion(b)
         # The joint's actual motion over the last step. Bullet's reported velocity can carry
         # motion that contacts undo at the position level (split impulse); feeding that back
         # into the drive makes a blocked finger push harder and harder.
         if b.q_prev is not None and b.q_prev_step == self._steps - 1:
             v = (q - b.q_prev) / dt
-        else:
-            v = np.array([s[1] for s in states])
         b.q_prev = q
         b.q_prev_step = self._steps
         minv, meff = self._mass_inverse(b, q)
@@ -729,12 +730,20 @@ class PyBulletBackend(Backend):
             np.array([s[0] for s in st]), np.array([s[1] for s in st]), np.array([s[3] for s in st])
         )
 
+    def _motion(self, b: _Body) -> tuple[np.ndarray, np.ndarray]:
+        """The body's joint positions and velocities, read once per step (shared, never mutated)."""
+        m = b.motion
+        if m is None or m[0] != self._steps:
+            st = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
+            m = b.motion = (self._steps, np.array([s[0] for s in st]), np.array([s[1] for s in st]))
+        return m[1], m[2]
+
     def get_joint_motion(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
         b = self._b(body)
         if not b.joints:
             return np.zeros(0), np.zeros(0)
-        st = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
-        return np.array([s[0] for s in st]), np.array([s[1] for s in st])
+        q, v = self._motion(b)
+        return q.copy(), v.copy()
 
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
@@ -744,6 +753,7 @@ class PyBulletBackend(Backend):
         pos = as_array(positions, len(sel), "positions")
         b.q_prev = None  # a teleport is not motion
         b.minv = None
+        b.motion = None
         for i, q in zip(sel, pos):
             pb.resetJointState(b.uid, b.joint_index[i], float(q), 0.0, physicsClientId=self._cid)
 
@@ -759,7 +769,7 @@ class PyBulletBackend(Backend):
         force_limit: float | Sequence[float] | None = None,
     ) -> None:
         b = self._b(body)
-        sel = np.asarray(b.joint_indices(joints), dtype=int)
+        sel = b.joint_selection(joints)
         n = len(sel)
         if n == 0:
             return

@@ -100,6 +100,9 @@ class _Body(BodyRecord):
         default_factory=dict
     )  #: last (q*, v*) sent
     gravity_tree: Any = None  #: cached (links, downstream mask, prismatic, masses) for a free base
+    #: (step, q, v) in our joint order, last read from PhysX: joints only change by stepping or a
+    #: teleport (set_joint_positions clears it); controllers read them several times a step
+    motion: tuple[int, np.ndarray, np.ndarray] | None = None
 
     @property
     def root(self) -> Any:
@@ -478,7 +481,11 @@ class SapienBackend(Backend):
         art = b.articulation
         if art is None or not b.joints:
             return np.zeros(0), np.zeros(0)
-        return np.asarray(art.qpos, dtype=float)[b.perm], np.asarray(art.qvel, dtype=float)[b.perm]
+        m = b.motion
+        if m is None or m[0] != self._steps:
+            q = np.asarray(art.qpos, dtype=float)[b.perm]
+            m = b.motion = (self._steps, q, np.asarray(art.qvel, dtype=float)[b.perm])
+        return m[1].copy(), m[2].copy()
 
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
@@ -494,6 +501,7 @@ class SapienBackend(Backend):
             v[b.perm[i]] = 0.0
         art.set_qpos(q)
         art.set_qvel(v)
+        b.motion = None
 
     def set_joint_targets(
         self,
@@ -507,7 +515,7 @@ class SapienBackend(Backend):
         force_limit: float | Sequence[float] | None = None,
     ) -> None:
         b = self._b(body)
-        sel = np.asarray(b.joint_indices(joints), dtype=int)
+        sel = b.joint_selection(joints)
         n = len(sel)
         if n == 0:
             return
