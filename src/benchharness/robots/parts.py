@@ -27,6 +27,22 @@ if TYPE_CHECKING:
 
 __all__ = ["GraspResult", "Gripper", "MotionResult", "RobotArm", "RobotHand"]
 
+#: KinematicChains built in this process, by (URDF text, root, tip, limits). A chain is immutable once
+#: built (IK draws from the generator it is given), and building one parses the whole URDF with
+#: pytorch-kinematics and checks the NumPy model against it (~0.3 s for the PR2): a worker running many
+#: trials, or a strategy that makes a new robot, builds each chain once.
+_CHAINS: dict[tuple, KinematicChain] = {}
+
+
+def _chain(
+    urdf_text: str, root: str, tip: str, limits: dict[str, tuple[float, float]]
+) -> KinematicChain:
+    key = (urdf_text, root, tip, tuple(sorted(limits.items())))
+    chain = _CHAINS.get(key)
+    if chain is None:
+        chain = _CHAINS[key] = KinematicChain(urdf_text, root, tip, limits=limits)
+    return chain
+
 
 @dataclass(frozen=True)
 class MotionResult:
@@ -84,11 +100,8 @@ class RobotArm:
     @property
     def chain(self) -> KinematicChain:
         if self._chain is None:
-            c = KinematicChain(
-                self.robot.urdf_text,
-                self.config.base_link,
-                self.config.tcp_link,
-                limits=self._limits(),
+            c = _chain(
+                self.robot.urdf_text, self.config.base_link, self.config.tcp_link, self._limits()
             )
             if tuple(c.joint_names) != tuple(self.config.joints):
                 raise ValueError(
@@ -225,11 +238,11 @@ class RobotArm:
                     np.pi * axis / np.linalg.norm(axis)
                 )
                 origin.set("rpy", " ".join(repr(float(x)) for x in r.as_euler("xyz")))
-            cache[turned] = KinematicChain(
+            cache[turned] = _chain(
                 ET.tostring(root, encoding="unicode"),
                 self.config.base_link,
                 self.config.tcp_link,
-                limits=self._limits(),
+                self._limits(),
             )
         return cache[turned]
 
