@@ -208,10 +208,10 @@ class PyBulletBackend(Backend):
             p, q = pb.getBasePositionAndOrientation(b.uid, physicsClientId=cid)
             if not math.isfinite(p[0] + p[1] + p[2] + q[0] + q[1] + q[2] + q[3]):
                 self._blowup(h)
-            if b.joints:
-                for st in pb.getJointStates(b.uid, b.joint_index, physicsClientId=cid):
-                    if not (math.isfinite(st[0]) and abs(st[1]) < MAX_SPEED):
-                        self._blowup(h)
+            if b.joints:  # read through the per-step cache: the next drive law and reads reuse it
+                q, v = self._motion(b)
+                if not (np.isfinite(q).all() and (np.abs(v) < MAX_SPEED).all()):  # NaN fails too
+                    self._blowup(h)
 
     def _blowup(self, h: int) -> None:
         b = self._bodies[h]

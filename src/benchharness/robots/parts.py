@@ -385,6 +385,7 @@ class Gripper:
             None  # (backend, step-callback handle) while moving
         )
         self._link_plan: tuple | None = None  # see _aim_linkages
+        self._aimed_at: float | None = None  # sim time of the last re-aim while moving (see update)
 
     @property
     def name(self) -> str:
@@ -461,6 +462,7 @@ class Gripper:
             if self._link_cb[0] is be:
                 be.remove_step_callback(self._link_cb[1])
             self._link_cb = None
+        self._aimed_at = be.time if moving else None
         if (
             not moving
             and self._link_sent is not None
@@ -480,7 +482,12 @@ class Gripper:
 
     def update(self) -> None:
         """Re-aim follower joints (called every control tick while the robot steps)."""
-        self._aim_linkages()
+        cb = self._link_cb
+        be = self.robot.backend
+        # while the fingers move, the step callback has already re-aimed them after this very step:
+        # the same measured joints would give the same targets again
+        if be is None or cb is None or cb[0] is not be or self._aimed_at != be.time:
+            self._aim_linkages()
         if not self.config.follow or self.robot.body is None:
             return
         pos = self.robot.joint_positions(self.joints)
