@@ -9,7 +9,11 @@ process (``--workers 0``, a throw-away store) with three counters:
 * ``trial``: CPU time of ``execute_trial`` (backend, robot and strategy set-up,
   the strategy's run, scoring, closing the backend);
 * ``total``: the child's whole CPU time (user + system, from ``wait4``),
-  interpreter start-up and exit included.
+  interpreter start-up and exit included;
+* ``trial_import``: CPU time of the (outermost) imports made during the trial
+  (the robot factory imports torch, the backend its engine...): paid once per
+  process, so the report also gives the ratio and fixed cost with these counted
+  as start-up, as a worker's later trials see them.
 
 It reports, per trial, the simulated seconds stepped per CPU-second of the
 engine alone (``engine_rate``) and of the whole trial (``trial_rate``), their
@@ -47,8 +51,39 @@ PROTOCOL = ["rubiks", "expect", "--sequence", "R U"]
 
 def _child(out: str, profile: str | None, argv: list[str]) -> None:
     """Run the CLI in this process with the engine and trial counters; write them to ``out``."""
-    counters = {"engine_cpu": 0.0, "engine_steps": 0, "trial_cpu": 0.0, "dt": 0.0}
+    counters = {
+        "engine_cpu": 0.0,
+        "engine_steps": 0,
+        "trial_cpu": 0.0,
+        "trial_import_cpu": 0.0,
+        "dt": 0.0,
+    }
     clock = time.process_time
+    if argv[0] == "run":
+        # CPU spent importing modules during the trial (torch, the engines...): paid once per
+        # process, so a worker running many trials pays it once (outermost imports only)
+        import builtins
+
+        original_import = builtins.__import__
+        depth = [0]
+        in_trial = [False]
+
+        def timed_import(*a, **kw):  # type: ignore[no-untyped-def]
+            if depth[0] or not in_trial[0]:
+                depth[0] += 1
+                try:
+                    return original_import(*a, **kw)
+                finally:
+                    depth[0] -= 1
+            depth[0] += 1
+            c0 = clock()
+            try:
+                return original_import(*a, **kw)
+            finally:
+                depth[0] -= 1
+                counters["trial_import_cpu"] += clock() - c0
+
+        builtins.__import__ = timed_import
     if argv[0] == "run":
         from benchharness.backends import interface
         from benchharness.runner import sweep
@@ -92,6 +127,7 @@ def _child(out: str, profile: str | None, argv: list[str]) -> None:
 
         def trial(*a, **kw):  # type: ignore[no-untyped-def]
             c0 = clock()
+            in_trial[0] = True
             try:
                 if profile:
                     import cProfile
@@ -103,6 +139,7 @@ def _child(out: str, profile: str | None, argv: list[str]) -> None:
                 return original_trial(*a, **kw)
             finally:
                 counters["trial_cpu"] += clock() - c0
+                in_trial[0] = False
 
         sweep.execute_trial = trial
     from benchharness.cli.main import cli
@@ -158,6 +195,11 @@ def measure_trial(
     r["trial_rate"] = sim / r["trial_cpu"] if r["trial_cpu"] else float("nan")
     r["ratio"] = r["engine_cpu"] / r["trial_cpu"] if r["trial_cpu"] else float("nan")
     r["fixed_cpu"] = r["total_cpu"] - r["trial_cpu"]
+    # the same with the trial's one-off imports counted as start-up (as in a worker's later trials)
+    warm = r["trial_cpu"] - r.get("trial_import_cpu", 0.0)
+    r["warm_trial_cpu"] = warm
+    r["warm_ratio"] = r["engine_cpu"] / warm if warm else float("nan")
+    r["warm_fixed_cpu"] = r["total_cpu"] - warm
     return r
 
 
@@ -200,7 +242,9 @@ def main() -> None:
                         f"{label:14s} {be:8s}{tag} sim {r['sim_s']:7.2f} s  engine {r['engine_cpu']:6.2f} "
                         f"CPU-s ({r['engine_rate']:5.1f} sim-s/CPU-s)  trial {r['trial_cpu']:6.2f} "
                         f"CPU-s ({r['trial_rate']:5.1f})  ratio {r['ratio']:.3f}  "
-                        f"fixed {r['fixed_cpu']:.2f} CPU-s  rc {r['rc']}",
+                        f"fixed {r['fixed_cpu']:.2f} CPU-s  rc {r['rc']} | trial's imports "
+                        f"{r['trial_import_cpu']:.2f} CPU-s: without them ratio {r['warm_ratio']:.3f}, "
+                        f"fixed {r['warm_fixed_cpu']:.2f} CPU-s",
                         flush=True,
                     )
     if a.protocol:
