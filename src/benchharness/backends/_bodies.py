@@ -40,7 +40,8 @@ def as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:
     a = np.asarray(v, dtype=float)
     if a.ndim == 0:
         return np.full(n, float(a))
-    a = a.reshape(-1)
+    if a.ndim != 1:
+        a = a.reshape(-1)
     if a.shape[0] != n:
         raise BackendError(f"{what}: expected {n} values, got {a.shape[0]}")
     return a
@@ -137,6 +138,7 @@ class BodyRecord:
     drive: DriveState = field(default_factory=lambda: DriveState.zeros(0))
     temp_files: list[str] = field(default_factory=list)  #: deleted with the body
     _jmap: dict[str, int] = field(default_factory=dict, repr=False)
+    _sel: dict[tuple[str, ...] | None, np.ndarray] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         if len(self.drive) != len(self.joints):
@@ -155,6 +157,17 @@ class BodyRecord:
             raise BackendError(
                 f"body {self.name!r} has no movable joint {exc.args[0]!r}; joints: {names}"
             ) from None
+
+    def joint_selection(self, joints: Sequence[str] | None) -> np.ndarray:
+        """:meth:`joint_indices` as an index array, cached per tuple of names (do not modify it).
+
+        Controllers re-target the same joint groups every control tick or physics step.
+        """
+        key = None if joints is None else tuple(joints)
+        sel = self._sel.get(key)
+        if sel is None:
+            sel = self._sel[key] = np.asarray(self.joint_indices(joints), dtype=int)
+        return sel
 
     def delete_temp_files(self) -> None:
         for f in self.temp_files:

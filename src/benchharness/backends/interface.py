@@ -437,6 +437,16 @@ class Backend(abc.ABC):
     @abc.abstractmethod
     def get_joint_state(self, body: BodyId) -> JointState: ...
 
+    def get_joint_motion(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        """``(positions, velocities)`` of :meth:`get_joint_state`, without the efforts.
+
+        Controllers read joint positions and velocities several times a physics
+        step; an engine that must compute efforts (PhysX reports none) can
+        skip that here. Fresh arrays each call, like :meth:`get_joint_state`.
+        """
+        st = self.get_joint_state(body)
+        return st.positions, st.velocities
+
     @abc.abstractmethod
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None

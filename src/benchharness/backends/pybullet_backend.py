@@ -17,6 +17,7 @@ Engine-specific choices, all so that the numbers mean what they mean on SAPIEN:
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import tempfile
@@ -107,6 +108,11 @@ class _Body(BodyRecord):
     gravity_base: np.ndarray | None = (
         None  #: world gravity in a fixed base's inertial frame (cached)
     )
+    gravity_tilted: bool = False  #: gravity_base differs from world gravity (cached with it)
+    #: (step, q, v) last read from the engine: joints only change by stepping or a teleport
+    #: (set_joint_positions clears it), and the drive law and the controllers read them several
+    #: times a step (see _motion)
+    motion: tuple[int, np.ndarray, np.ndarray] | None = None
     driven_pb: list[int] = field(default_factory=list)
     ones: list[float] = field(default_factory=list)  #: velocity gains (1.0) for driven_pb
     drive_cache: tuple | None = (
@@ -151,6 +157,8 @@ class PyBulletBackend(Backend):
         self._grounds: dict[int, float] = {}
         self._palettes: dict[tuple[tuple[int, int, int], ...], int] = {}  #: colours -> texture id
         self._gravity = np.asarray(c.gravity, dtype=float)
+        #: the engine's own step (bench/bench_speed.py times this call to find the engine's floor)
+        self._engine_step = functools.partial(pb.stepSimulation, physicsClientId=self._cid)
 
     # -- lifetime --------------------------------------------------------------
     def close(self) -> None:
@@ -211,7 +219,7 @@ class PyBulletBackend(Backend):
             driven, dynamic = self._stepped()
             for b in driven:
                 self._apply_drives(b)
-            pb.stepSimulation(physicsClientId=cid)
+            self._engine_step()
             self._steps += 1
             for uid, h in dynamic:
                 lin, ang = pb.getBaseVelocity(uid, physicsClientId=cid)
@@ -232,10 +240,10 @@ class PyBulletBackend(Backend):
             p, q = pb.getBasePositionAndOrientation(b.uid, physicsClientId=cid)
             if not math.isfinite(p[0] + p[1] + p[2] + q[0] + q[1] + q[2] + q[3]):
                 self._blowup(h)
-            if b.joints:
-                for st in pb.getJointStates(b.uid, b.joint_index, physicsClientId=cid):
-                    if not (math.isfinite(st[0]) and abs(st[1]) < MAX_SPEED):
-                        self._blowup(h)
+            if b.joints:  # read through the per-step cache: the next drive law and reads reuse it
+                q, v = self._motion(b)
+                if not (np.isfinite(q).all() and (np.abs(v) < MAX_SPEED).all()):  # NaN fails too
+                    self._blowup(h)
 
     def _blowup(self, h: int) -> None:
         b = self._bodies[h]
@@ -261,9 +269,11 @@ class PyBulletBackend(Backend):
         if gb is None:
             _, orn = pb.getBasePositionAndOrientation(b.uid, physicsClientId=cid)
             gb = np.asarray(pb.getMatrixFromQuaternion(orn), dtype=float).reshape(3, 3).T @ g
+            tilted = bool(np.max(np.abs(gb - g)) > 1e-12)
             if b.fixed:  # a fixed base only turns through set_pose, which clears this
-                b.gravity_base = gb
-        tilted = bool(np.max(np.abs(gb - g)) > 1e-12)
+                b.gravity_base, b.gravity_tilted = gb, tilted
+        else:
+            tilted = b.gravity_tilted
         if tilted:
             pb.setGravity(*gb.tolist(), physicsClientId=cid)
         try:
@@ -304,7 +314,7 @@ class PyBulletBackend(Backend):
         if (
             b.minv is None
             or b.minv_q is None
-            or float(np.max(np.abs(q - b.minv_q))) > MASS_MATRIX_REFRESH
+            or float(np.abs(q - b.minv_q).max()) > MASS_MATRIX_REFRESH
         ):
             m = np.array(
                 pb.calculateMassMatrix(b.uid, q.tolist(), physicsClientId=self._cid), dtype=float
@@ -341,15 +351,12 @@ class PyBulletBackend(Backend):
         """
         dt = self.config.timestep
         sel = b.driven_idx
-        states = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
-        q = np.array([s[0] for s in states])
+        q, v = self._motion(b)
         # The joint's actual motion over the last step. Bullet's reported velocity can carry
         # motion that contacts undo at the position level (split impulse); feeding that back
         # into the drive makes a blocked finger push harder and harder.
         if b.q_prev is not None and b.q_prev_step == self._steps - 1:
             v = (q - b.q_prev) / dt
-        else:
-            v = np.array([s[1] for s in states])
         b.q_prev = q
         b.q_prev_step = self._steps
         minv, meff = self._mass_inverse(b, q)
@@ -357,8 +364,7 @@ class PyBulletBackend(Backend):
             ds = b.drive
             k, d = ds.kp[sel], ds.kd[sel]
             c = k * dt + d
-            with np.errstate(divide="ignore"):
-                inv_c = np.where(c > 0, 1.0 / c, 0.0)
+            inv_c = np.divide(1.0, c, out=np.zeros_like(c), where=c > 0)
             b.drive_cache = (
                 k,
                 d * ds.target_v[sel],
@@ -828,6 +834,21 @@ class PyBulletBackend(Backend):
             np.array([s[0] for s in st]), np.array([s[1] for s in st]), np.array([s[3] for s in st])
         )
 
+    def _motion(self, b: _Body) -> tuple[np.ndarray, np.ndarray]:
+        """The body's joint positions and velocities, read once per step (shared, never mutated)."""
+        m = b.motion
+        if m is None or m[0] != self._steps:
+            st = pb.getJointStates(b.uid, b.joint_index, physicsClientId=self._cid)
+            m = b.motion = (self._steps, np.array([s[0] for s in st]), np.array([s[1] for s in st]))
+        return m[1], m[2]
+
+    def get_joint_motion(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        b = self._b(body)
+        if not b.joints:
+            return np.zeros(0), np.zeros(0)
+        q, v = self._motion(b)
+        return q.copy(), v.copy()
+
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
     ) -> None:
@@ -836,6 +857,7 @@ class PyBulletBackend(Backend):
         pos = as_array(positions, len(sel), "positions")
         b.q_prev = None  # a teleport is not motion
         b.minv = None
+        b.motion = None
         for i, q in zip(sel, pos):
             pb.resetJointState(b.uid, b.joint_index[i], float(q), 0.0, physicsClientId=self._cid)
 
@@ -851,7 +873,7 @@ class PyBulletBackend(Backend):
         force_limit: float | Sequence[float] | None = None,
     ) -> None:
         b = self._b(body)
-        sel = np.asarray(b.joint_indices(joints), dtype=int)
+        sel = b.joint_selection(joints)
         n = len(sel)
         if n == 0:
             return
@@ -865,11 +887,13 @@ class PyBulletBackend(Backend):
             force_limit,
             lambda: self.get_joint_state(body).positions,
         )
+        newly_driven = not b.drive.driven[sel].all()
         b.drive.set_targets(sel, cmd)
-        self._step_lists = None  # the body may be newly driven
-        b.driven_idx = np.nonzero(b.drive.driven)[0]
-        b.driven_pb = [b.joint_index[i] for i in b.driven_idx]
-        b.ones = [1.0] * len(b.driven_pb)
+        if newly_driven:  # re-targeting driven joints (most calls) keeps the lists
+            self._step_lists = None
+            b.driven_idx = np.nonzero(b.drive.driven)[0]
+            b.driven_pb = [b.joint_index[i] for i in b.driven_idx]
+            b.ones = [1.0] * len(b.driven_pb)
         b.drive_cache = None
 
     def set_joint_friction(

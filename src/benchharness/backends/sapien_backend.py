@@ -100,6 +100,9 @@ class _Body(BodyRecord):
         default_factory=dict
     )  #: last (q*, v*) sent
     gravity_tree: Any = None  #: cached (links, downstream mask, prismatic, masses) for a free base
+    #: (step, q, v) in our joint order, last read from PhysX: joints only change by stepping or a
+    #: teleport (set_joint_positions clears it); controllers read them several times a step
+    motion: tuple[int, np.ndarray, np.ndarray] | None = None
 
     @property
     def root(self) -> Any:
@@ -126,6 +129,8 @@ class SapienBackend(Backend):
         self._system = physx.PhysxCpuSystem()
         self._scene = sapien.Scene([self._system])
         self._scene.set_timestep(c.timestep)
+        #: the engine's own step (bench/bench_speed.py times this call to find the engine's floor)
+        self._engine_step: Any = self._system.step
         self._bodies: BodyTable[_Body] = BodyTable()
         self._entity_map: dict[int, tuple[int, str | None]] = {}  # per_scene_id -> (handle, link)
         self._constraints: dict[int, Any] = {}
@@ -166,6 +171,7 @@ class SapienBackend(Backend):
             pass
         self._scene = None
         self._system = None
+        self._engine_step = None
 
     # -- helpers ---------------------------------------------------------------
     def _b(self, body: BodyId) -> _Body:
@@ -211,7 +217,7 @@ class SapienBackend(Backend):
                 # bases that can move (a fixed base cannot; joints are checked after the loop)
                 self._roots = [(h, b.root) for h, b in self._bodies.items() if not b.fixed]
             roots = self._roots
-            self._scene.step()
+            self._engine_step()
             self._steps += 1
             for h, comp in roots:
                 lv = comp.linear_velocity
@@ -472,6 +478,17 @@ class SapienBackend(Backend):
         # PhysX does not report drive forces: evaluate the (capped) drive law at the current state
         return JointState(q, v, b.drive.efforts(q, v))
 
+    def get_joint_motion(self, body: BodyId) -> tuple[np.ndarray, np.ndarray]:
+        b = self._b(body)
+        art = b.articulation
+        if art is None or not b.joints:
+            return np.zeros(0), np.zeros(0)
+        m = b.motion
+        if m is None or m[0] != self._steps:
+            q = np.asarray(art.qpos, dtype=float)[b.perm]
+            m = b.motion = (self._steps, q, np.asarray(art.qvel, dtype=float)[b.perm])
+        return m[1].copy(), m[2].copy()
+
     def set_joint_positions(
         self, body: BodyId, positions: Sequence[float], joints: Sequence[str] | None = None
     ) -> None:
@@ -486,6 +503,7 @@ class SapienBackend(Backend):
             v[b.perm[i]] = 0.0
         art.set_qpos(q)
         art.set_qvel(v)
+        b.motion = None
 
     def set_joint_targets(
         self,
@@ -499,7 +517,7 @@ class SapienBackend(Backend):
         force_limit: float | Sequence[float] | None = None,
     ) -> None:
         b = self._b(body)
-        sel = np.asarray(b.joint_indices(joints), dtype=int)
+        sel = b.joint_selection(joints)
         n = len(sel)
         if n == 0:
             return

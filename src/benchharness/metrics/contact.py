@@ -48,11 +48,13 @@ import hashlib
 from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal, Union
 
 import numpy as np
-import trimesh
 from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:  # trimesh is imported where it is used: a Rubik's run never needs it (0.2 s)
+    import trimesh
 
 __all__ = [
     "ContactError",
@@ -70,7 +72,9 @@ DEFAULT_CONTACT_TOL = 2e-3
 GeodesicMethod = Literal["heat", "exact"]
 #: A region or robot contact: a mesh, several meshes (robot links), object
 #: vertex indices (integer 1-D array), or points ((n, 3) float array).
-ContactSpec = trimesh.Trimesh | Sequence[trimesh.Trimesh] | np.ndarray | Sequence[Sequence[float]]
+ContactSpec = Union[
+    "trimesh.Trimesh", Sequence["trimesh.Trimesh"], np.ndarray, Sequence[Sequence[float]]
+]
 
 
 @dataclass(frozen=True)
@@ -103,6 +107,8 @@ class ObjectSurface:
     """
 
     def __init__(self, mesh: trimesh.Trimesh):
+        import trimesh
+
         if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
             raise TypeError("ObjectSurface needs a non-empty trimesh.Trimesh")
         self.mesh = mesh
@@ -147,6 +153,9 @@ class ObjectSurface:
         self, part: trimesh.Trimesh, contact_tol: float = DEFAULT_CONTACT_TOL
     ) -> np.ndarray:
         """``intersect``: points of ``part`` within ``contact_tol`` of the surface."""
+        import trimesh.proximity
+        import trimesh.remesh
+
         v, f = np.asarray(part.vertices, float), np.asarray(part.faces, np.int64)
         if len(f):
             v, f = trimesh.remesh.subdivide_to_size(v, f, max_edge=self.mean_edge, max_iter=12)
@@ -221,6 +230,8 @@ class ObjectSurface:
         self, spec: ContactSpec, contact_tol: float = DEFAULT_CONTACT_TOL
     ) -> np.ndarray:
         """Object vertices for a region / contact given in any accepted form."""
+        import trimesh
+
         if isinstance(spec, trimesh.Trimesh):
             return np.unique(self.min_vertex(self.intersect(spec, contact_tol)))
         if (

@@ -27,6 +27,22 @@ if TYPE_CHECKING:
 
 __all__ = ["GraspResult", "Gripper", "MotionResult", "RobotArm", "RobotHand"]
 
+#: KinematicChains built in this process, by (URDF text, root, tip, limits). A chain is immutable once
+#: built (IK draws from the generator it is given), and building one parses the whole URDF with
+#: pytorch-kinematics and checks the NumPy model against it (~0.3 s for the PR2): a worker running many
+#: trials, or a strategy that makes a new robot, builds each chain once.
+_CHAINS: dict[tuple, KinematicChain] = {}
+
+
+def _chain(
+    urdf_text: str, root: str, tip: str, limits: dict[str, tuple[float, float]]
+) -> KinematicChain:
+    key = (urdf_text, root, tip, tuple(sorted(limits.items())))
+    chain = _CHAINS.get(key)
+    if chain is None:
+        chain = _CHAINS[key] = KinematicChain(urdf_text, root, tip, limits=limits)
+    return chain
+
 
 @dataclass(frozen=True)
 class MotionResult:
@@ -84,11 +100,8 @@ class RobotArm:
     @property
     def chain(self) -> KinematicChain:
         if self._chain is None:
-            c = KinematicChain(
-                self.robot.urdf_text,
-                self.config.base_link,
-                self.config.tcp_link,
-                limits=self._limits(),
+            c = _chain(
+                self.robot.urdf_text, self.config.base_link, self.config.tcp_link, self._limits()
             )
             if tuple(c.joint_names) != tuple(self.config.joints):
                 raise ValueError(
@@ -225,11 +238,11 @@ class RobotArm:
                     np.pi * axis / np.linalg.norm(axis)
                 )
                 origin.set("rpy", " ".join(repr(float(x)) for x in r.as_euler("xyz")))
-            cache[turned] = KinematicChain(
+            cache[turned] = _chain(
                 ET.tostring(root, encoding="unicode"),
                 self.config.base_link,
                 self.config.tcp_link,
-                limits=self._limits(),
+                self._limits(),
             )
         return cache[turned]
 
@@ -371,6 +384,8 @@ class Gripper:
         self._link_cb: tuple[object, int] | None = (
             None  # (backend, step-callback handle) while moving
         )
+        self._link_plan: tuple | None = None  # see _aim_linkages
+        self._aimed_at: float | None = None  # sim time of the last re-aim while moving (see update)
 
     @property
     def name(self) -> str:
@@ -424,18 +439,30 @@ class Gripper:
         be = self.robot.backend
         if not links or be is None or self.robot.body is None:
             return
-        leaders = [k.leader for k in links]
-        pos = self.robot.joint_positions(leaders)
-        vel = self.robot.joint_velocities(leaders)
-        t = np.array([k.target(float(p)) for k, p in zip(links, pos)])
-        v = np.array([k.rate(float(p)) * float(w) for k, p, w in zip(links, pos, vel)])
-        moving = bool(np.max(np.abs(vel)) > 1e-4)
+        # this runs after every physics step while a finger moves: names and gains are built once
+        plan = self._link_plan
+        if plan is None:
+            names = [k.follower for k in links]
+            plan = self._link_plan = (
+                tuple(k.leader for k in links),
+                names,
+                [k.stiffness for k in links],
+                [k.damping for k in links],
+                [self.robot.urdf_joints[n].effort for n in names],
+            )
+        leaders, names, stiffness, damping, force_limit = plan
+        pos, vel = self.robot.joint_motion(leaders)
+        pl = pos.tolist()
+        t = np.array([k.target(p) for k, p in zip(links, pl)])
+        v = np.array([k.rate(p) * w for k, p, w in zip(links, pl, vel.tolist())])
+        moving = bool(np.abs(vel).max() > 1e-4)
         if moving and (self._link_cb is None or self._link_cb[0] is not be):
             self._link_cb = (be, be.add_step_callback(self._aim_linkages))
         elif not moving and self._link_cb is not None:
             if self._link_cb[0] is be:
                 be.remove_step_callback(self._link_cb[1])
             self._link_cb = None
+        self._aimed_at = be.time if moving else None
         if (
             not moving
             and self._link_sent is not None
@@ -443,20 +470,24 @@ class Gripper:
         ):
             return
         self._link_sent = None if moving else t
-        names = [k.follower for k in links]
         be.set_joint_targets(
             self.robot.body,
             t,
             v,
             joints=names,
-            stiffness=[k.stiffness for k in links],
-            damping=[k.damping for k in links],
-            force_limit=[self.robot.urdf_joints[n].effort for n in names],
+            stiffness=stiffness,
+            damping=damping,
+            force_limit=force_limit,
         )
 
     def update(self) -> None:
         """Re-aim follower joints (called every control tick while the robot steps)."""
-        self._aim_linkages()
+        cb = self._link_cb
+        be = self.robot.backend
+        # while the fingers move, the step callback has already re-aimed them after this very step:
+        # the same measured joints would give the same targets again
+        if be is None or cb is None or cb[0] is not be or self._aimed_at != be.time:
+            self._aim_linkages()
         if not self.config.follow or self.robot.body is None:
             return
         pos = self.robot.joint_positions(self.joints)

@@ -64,6 +64,7 @@ class Robot:
         self._gcache: tuple[np.ndarray, np.ndarray] | None = None
         self._gj: tuple[str, ...] | None = None
         self._plans: dict[tuple[str, ...], tuple] = {}
+        self._index: dict[tuple[str, ...], np.ndarray] = {}  #: joint names -> indices (cached)
 
     # -- description -------------------------------------------------------------
     @property
@@ -194,17 +195,32 @@ class Robot:
             raise RuntimeError(f"robot {self.name!r} is not spawned: call spawn(backend) first")
         return self.backend
 
+    def joint_index(self, joints: Sequence[str]) -> np.ndarray:
+        """Indices of ``joints`` in :attr:`joint_names` (cached per tuple of names)."""
+        key = tuple(joints)
+        idx = self._index.get(key)
+        if idx is None:
+            idx = np.array([self.joint_names.index(j) for j in key], dtype=int)
+            self._index[key] = idx
+        return idx
+
     def joint_positions(self, joints: Sequence[str] | None = None) -> np.ndarray:
-        st = self._require().get_joint_state(self.body)
+        q, _ = self._require().get_joint_motion(self.body)
         if joints is None:
-            return st.positions
-        return st.positions[[self.joint_names.index(j) for j in joints]]
+            return q
+        return q[self.joint_index(joints)]
 
     def joint_velocities(self, joints: Sequence[str] | None = None) -> np.ndarray:
-        st = self._require().get_joint_state(self.body)
+        _, v = self._require().get_joint_motion(self.body)
         if joints is None:
-            return st.velocities
-        return st.velocities[[self.joint_names.index(j) for j in joints]]
+            return v
+        return v[self.joint_index(joints)]
+
+    def joint_motion(self, joints: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities of ``joints``, read together (one engine query)."""
+        q, v = self._require().get_joint_motion(self.body)
+        idx = self.joint_index(joints)
+        return q[idx], v[idx]
 
     def _gravity_joints(self) -> list[str]:
         """Every joint but the grippers' (a new list each call; the names are computed once)."""
@@ -283,7 +299,7 @@ class Robot:
         time, and the torques only change when the configuration does (1e-4 rad).
         """
         be = self._require()
-        q = be.get_joint_state(self.body).positions
+        q, _ = be.get_joint_motion(self.body)
         if self._gcache is None or np.max(np.abs(q - self._gcache[0])) > 1e-4:
             if be.capabilities.gravity_torques:
                 tau = np.asarray(be.gravity_torques(self.body), dtype=float)
@@ -348,9 +364,9 @@ class Robot:
             t = k * per * dt
             q_ref, qd_ref = traj.sample(t)
             if k:
-                st = be.get_joint_state(self.body)
-                max_err = max(max_err, float(np.max(np.abs(st.positions[idx] - q_ref))))
-                peak_ratio = max(peak_ratio, float(np.max(np.abs(st.velocities[idx]) / vmax)))
+                pos, vel = be.get_joint_motion(self.body)
+                max_err = max(max_err, float(np.max(np.abs(pos[idx] - q_ref))))
+                peak_ratio = max(peak_ratio, float(np.max(np.abs(vel[idx]) / vmax)))
             self.drive(joints, q_ref, qd_ref)
             if others:
                 self.hold(others)

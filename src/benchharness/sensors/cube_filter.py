@@ -36,7 +36,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from filterpy.kalman import ExtendedKalmanFilter
 
 from ..geometry import Pose
 from .config import CubeFilterConfig, ToFConfig
@@ -90,6 +89,9 @@ class CubePoseFilter:
         self.config = config or CubeFilterConfig()
         #: The range noise model used for R; it should match the sensors' ToFConfig.
         self.tof = tof or ToFConfig()
+        # imported here: filterpy's package import pulls in scipy.stats etc. (~0.2 s at start-up)
+        from filterpy.kalman import ExtendedKalmanFilter
+
         self._kf = ExtendedKalmanFilter(dim_x=_DIM, dim_z=1)
         self._kf.B = np.eye(_DIM)
         self._n = 0
