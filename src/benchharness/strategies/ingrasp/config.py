@@ -39,16 +39,23 @@ class IngraspConfig:
     #: single 4-joint finger cannot carry the object to the published goals (median 1.3 cm short
     #: at best), see docs/ingrasp.md.
     object_frame: str = "fingertips"
-    # goal (object pose at the last waypoint)
-    w_goal_pos: float = 1.0e6
-    w_goal_rot: float = 1.0e4
-    # relaxed-rigidity family: change of fingertip j against the object, per waypoint
-    w_rigid_pos: float = 1.0e3
-    w_rigid_rot: float = 1.0e1
+    # All weights multiply squared residuals in SI units (m, rad). One rule sets them: a metre of
+    # fingertip slip against the object weighs as much as a metre of object pose error, and a
+    # radian as much as 10 cm (1 cm ~ 5.7 deg). The rigidity terms are summed over the T waypoints
+    # and the fingers, the goal term is one pose: keeping the grasp outweighs the last millimetres
+    # of goal (the relaxed rigidity acts as the near-constraint its name says). docs/ingrasp.md.
+    w_goal_pos: float = 1.0e4  #: object position at the last waypoint vs goal (m^2)
+    w_goal_rot: float = 1.0e2  #: object orientation at the last waypoint vs goal (rad^2)
+    #: relaxed rigidity: fingertip position in the object frame vs its initial one, per waypoint and finger
+    w_rigid_pos: float = 1.0e4
+    #: relaxed-position-orientation only: fingertip orientation relative to the object, likewise
+    w_rigid_rot: float = 1.0e2
     # object-path variants: fingertip targets on the interpolated object path ("constraints")
-    w_contact_pos: float = 1.0e5
-    w_contact_rot: float = 1.0e3
-    w_smooth: float = 1.0e-1  #: sum of squared joint steps (rad^2)
+    w_contact_pos: float = 1.0e6
+    w_contact_rot: float = 1.0e4
+    #: joint-velocity smoothness, sum of squared joint steps (rad^2): a 0.1 rad step weighs as much
+    #: as 0.1 mm of goal error, so it only chooses among trajectories that keep the grasp equally well
+    w_smooth: float = 1.0e-2
     w_limits: float = (
         1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
     )

@@ -153,11 +153,30 @@ class _Cost:
         )  # object in its carrier frame
         rel = inverse(self.x_o0)[None] @ x0  # fingertips in the object frame (k, 4, 4)
         self.tip_in_obj = rel
-        self.obj_in_tip = inverse(x0) @ self.x_o0[None]  # object in each fingertip frame
         if variant in OBJECT_PATH:
             s = np.arange(1, cfg.waypoints + 1) / cfg.waypoints
             path = interpolate_poses(problem.object_initial, problem.goal, s)  # (T, 4, 4)
             self.targets = t(path)[:, None] @ rel[None]  # (T, k, 4, 4)
+
+    def rigidity_residuals(
+        self, x: torch.Tensor, x_o: torch.Tensor, first: int = 0
+    ) -> list[torch.Tensor]:
+        """Relaxed-rigidity residuals: each fingertip's pose in the object frame against its initial one.
+
+        ``x`` (T, k, 4, 4) fingertip poses, ``x_o`` (T, 4, 4) object poses, both in
+        the palm frame. Position residuals (m) for every finger from ``first``
+        on, weighted ``w_rigid_pos``; for relaxed-position-orientation also the
+        fingertip's orientation relative to the object (``w_rigid_rot``). Zero
+        for any trajectory that moves fingertips and object as one rigid body.
+        """
+        cfg = self.cfg
+        in_obj = inverse(x_o)[:, None] @ x[:, first:]  # fingertips in the object frame now
+        ref = self.tip_in_obj[None, first:]
+        out = [(cfg.w_rigid_pos**0.5) * (in_obj[..., :3, 3] - ref[..., :3, 3]).reshape(-1)]
+        if self.variant == "relaxed-position-orientation":
+            r = rot_residual(ref[..., :3, :3], in_obj[..., :3, :3])
+            out.append((cfg.w_rigid_rot**0.5) * r.reshape(-1))
+        return out
 
     def residuals(self, q: torch.Tensor) -> torch.Tensor:
         """All weighted residuals as one vector; the cost is its squared norm (a least-squares problem)."""
@@ -167,35 +186,13 @@ class _Cost:
         parts = []
         if v in RELAXED:
             x_o = carrier_frames(x, cfg.object_frame) @ self.attach  # (T, 4, 4)
-            first = (
-                1 if cfg.object_frame == "reference-finger" else 0
-            )  # the carrier finger cannot slip
-            others = x[:, first:]
-            if v == "relaxed-rigidity":
-                pred = (
-                    others @ self.obj_in_tip[None, first:]
-                )  # object as each fingertip would carry it
-                parts.append(sq(cfg.w_rigid_pos, pred[..., :3, 3] - x_o[:, None, :3, 3]))
-                parts.append(
-                    sq(cfg.w_rigid_rot, rot_residual(x_o[:, None, :3, :3], pred[..., :3, :3]))
-                )
-            else:
-                in_obj = inverse(x_o)[:, None] @ others  # fingertips in the object frame now
-                parts.append(
-                    sq(cfg.w_rigid_pos, in_obj[..., :3, 3] - self.tip_in_obj[None, first:, :3, 3])
-                )
-                if v == "relaxed-position-orientation":
-                    parts.append(
-                        sq(
-                            cfg.w_rigid_rot,
-                            rot_residual(
-                                self.tip_in_obj[None, first:, :3, :3], in_obj[..., :3, :3]
-                            ),
-                        )
-                    )
+            # the carrier finger (reference-finger model) is the object's frame: it cannot slip
+            first = 1 if cfg.object_frame == "reference-finger" else 0
+            parts.extend(self.rigidity_residuals(x, x_o, first))
             xf = x_o[-1]
             parts.append(sq(cfg.w_goal_pos, xf[:3, 3] - self.goal[:3, 3]))
-            parts.append(sq(cfg.w_goal_rot, rot_residual(self.goal[:3, :3], xf[:3, :3])))
+            if v != "relaxed-position":  # relaxed-position: the object's position is the goal
+                parts.append(sq(cfg.w_goal_rot, rot_residual(self.goal[:3, :3], xf[:3, :3])))
         else:
             parts.append(sq(cfg.w_contact_pos, x[..., :3, 3] - self.targets[..., :3, 3]))
             if v == "ik-rigid":
