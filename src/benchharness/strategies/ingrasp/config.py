@@ -1,14 +1,12 @@
 """Settings of the in-grasp trajectory optimiser and the five Level I variants.
 
 Weights are per squared residual, with positions in metres and rotations in
-radians (rotation residuals are ``sin(angle) * axis``). 1 cm of position
-error weighs as much as ~5.7 deg of orientation error throughout. The goal
-weighs 1000x a fingertip's slip against the object at one waypoint: with a
-100x smaller goal weight the optimum stopped ~1 cm short of reachable goals
-(the slip cost, summed over the waypoints, wins), which is a trade-off of
-weights, not a property of the method; the benchmark measures whether the
-goal is reached, so the goal dominates and rigidity shapes *how* it is
-reached.
+radians (rotation residuals are ``sin(angle) * axis``); 1 cm of position
+weighs as much as ~5.7 deg of orientation throughout. One rule sets the
+relaxed variants' weights: a metre of fingertip slip against the object
+(per waypoint and finger) weighs as much as a metre of goal error, so the
+rigidity, summed over the waypoints and fingers, dominates the one goal term.
+The papers' own weights were not available to us (docs/ingrasp.md).
 """
 
 from __future__ import annotations
@@ -44,6 +42,9 @@ class IngraspConfig:
     # radian as much as 10 cm (1 cm ~ 5.7 deg). The rigidity terms are summed over the T waypoints
     # and the fingers, the goal term is one pose: keeping the grasp outweighs the last millimetres
     # of goal (the relaxed rigidity acts as the near-constraint its name says). docs/ingrasp.md.
+    #: the goal cost at every waypoint (True) or at the last only (False, default): every waypoint
+    #: pulled to an unreachable-yet goal stretches the grasp (measured, docs/ingrasp.md)
+    goal_every_waypoint: bool = False
     w_goal_pos: float = 1.0e4  #: object position at the last waypoint vs goal (m^2)
     w_goal_rot: float = 1.0e2  #: object orientation at the last waypoint vs goal (rad^2)
     #: relaxed rigidity: fingertip position in the object frame vs its initial one, per waypoint and finger
@@ -59,10 +60,17 @@ class IngraspConfig:
     w_limits: float = (
         1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
     )
-    max_iterations: int = 150  #: L-BFGS iterations in all (the planning-time budget)
-    inner_iterations: int = 25  #: per L-BFGS call; convergence is checked between calls
+    #: ``"lbfgs"``: L-BFGS on the sum of squares (default, measured); ``"lm"``: Levenberg-Marquardt
+    #: on the residuals (opt-in, not yet measured in simulation; docs/ingrasp.md "Solver budget")
+    solver: str = "lbfgs"
+    max_iterations: int = (
+        150  #: solver iterations in all (L-BFGS iterations; LM: Jacobian evaluations)
+    )
+    inner_iterations: int = (
+        25  #: L-BFGS only: iterations per call; convergence is checked between calls
+    )
     ftol: float = (
-        1.0e-6  #: relative cost decrease over one call below which the optimiser is converged
+        1.0e-6  #: relative cost decrease of one call (L-BFGS) or iteration (LM): converged
     )
     gtol: float = 1.0e-7  #: gradient max-norm below which the optimiser is converged
     init_noise: float = 1.0e-4  #: rad, seeded perturbation of the constant initial trajectory
@@ -76,6 +84,8 @@ class IngraspConfig:
             raise ValueError(
                 f"object_frame must be 'reference-finger' or 'fingertips', not {self.object_frame!r}"
             )
+        if self.solver not in ("lm", "lbfgs"):
+            raise ValueError(f"solver must be 'lm' or 'lbfgs', not {self.solver!r}")
         if self.duration_s <= 0 or self.max_joint_speed <= 0:
             raise ValueError("duration_s and max_joint_speed must be positive")
 

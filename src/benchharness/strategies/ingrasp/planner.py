@@ -189,10 +189,14 @@ class _Cost:
             # the carrier finger (reference-finger model) is the object's frame: it cannot slip
             first = 1 if cfg.object_frame == "reference-finger" else 0
             parts.extend(self.rigidity_residuals(x, x_o, first))
-            xf = x_o[-1]
-            parts.append(sq(cfg.w_goal_pos, xf[:3, 3] - self.goal[:3, 3]))
+            # the object pose cost at every waypoint (not only the last): each waypoint is pulled
+            # towards the goal as far as the velocity limit lets it
+            xs = x_o if cfg.goal_every_waypoint else x_o[-1:]
+            parts.append(sq(cfg.w_goal_pos, xs[:, :3, 3] - self.goal[None, :3, 3]))
             if v != "relaxed-position":  # relaxed-position: the object's position is the goal
-                parts.append(sq(cfg.w_goal_rot, rot_residual(self.goal[:3, :3], xf[:3, :3])))
+                parts.append(
+                    sq(cfg.w_goal_rot, rot_residual(self.goal[None, :3, :3], xs[:, :3, :3]))
+                )
         else:
             parts.append(sq(cfg.w_contact_pos, x[..., :3, 3] - self.targets[..., :3, 3]))
             if v == "ik-rigid":
@@ -255,6 +259,61 @@ def _lbfgs(
     return z.detach(), converged, iters, final
 
 
+def _levenberg_marquardt(
+    cost: _Cost, init: torch.Tensor, cfg: IngraspConfig
+) -> tuple[torch.Tensor, bool, int, float]:
+    """Minimise the sum of squared residuals from ``init`` with Levenberg-Marquardt.
+
+    The cost is a least-squares problem (:meth:`_Cost.residuals`); its
+    Jacobian comes from forward-mode autodiff (``torch.func.jacfwd``) through
+    the fingertip FK. Gauss-Newton steps are insensitive to how stiff the
+    weights make the problem (rigidity summed over every waypoint against one
+    goal term), where a gradient method needs thousands of iterations.
+    Converged: a step lowered the cost by less than ``ftol`` (relative), or the
+    gradient is below ``gtol``; not converged: ``max_iterations`` spent or the
+    damping ran away.
+    """
+    z = init.clone()
+    n = z.numel()
+
+    def res(y: torch.Tensor) -> torch.Tensor:
+        return cost.residuals(y.reshape(z.shape))
+
+    r = res(z.reshape(-1))
+    f = float(r @ r)
+    lam, converged, it = 1.0e-3, False, 0
+    eye = torch.eye(n, dtype=DTYPE)
+    while it < cfg.max_iterations:
+        it += 1
+        jac = torch.func.jacfwd(res)(z.reshape(-1))  # (m, n)
+        g = jac.T @ r
+        if float(g.abs().max()) <= cfg.gtol:
+            converged = True
+            break
+        h = jac.T @ jac
+        d = torch.diagonal(h).clamp_min(1.0e-12)
+        accepted = False
+        while lam < 1.0e12:
+            step = torch.linalg.solve(h + lam * torch.diag(d) + 1.0e-12 * eye, -g)
+            z_new = z + step.reshape(z.shape)
+            r_new = res(z_new.reshape(-1))
+            f_new = float(r_new @ r_new)
+            if f_new < f:
+                accepted = True
+                break
+            lam *= 4.0
+        if not accepted:  # no descent left at any damping: a (numerical) minimum
+            converged = True
+            break
+        decrease = f - f_new
+        z, r, f = z_new, r_new, f_new
+        lam = max(lam / 3.0, 1.0e-9)
+        if decrease <= cfg.ftol * max(1.0, f):
+            converged = True
+            break
+    return z.detach(), converged, it, f
+
+
 def plan(
     hand: HandKinematics,
     problem: InGraspProblem,
@@ -270,7 +329,8 @@ def plan(
     gen = torch.Generator().manual_seed(cfg.seed)
     init = cost_fn.q0[None].repeat(cfg.waypoints, 1)
     init = init + cfg.init_noise * torch.randn(init.shape, generator=gen, dtype=DTYPE)
-    z, converged, iters, final_cost = _lbfgs(cost_fn, init, cfg)
+    solve = _levenberg_marquardt if cfg.solver == "lm" else _lbfgs
+    z, converged, iters, final_cost = solve(cost_fn, init, cfg)
     q_opt = z.detach().numpy()
     lo, hi = hand.limits(problem.fingers)
     q_proj = project_trajectory(
