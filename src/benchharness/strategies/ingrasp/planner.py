@@ -8,12 +8,10 @@ fixes the offset), so the object pose at every waypoint is forward
 kinematics. Variants differ in how the fingertips are kept on the object
 (see ``docs/ingrasp.md``):
 
-* ``relaxed-rigidity``: each fingertip is modelled as rigidly attached too,
-  and the disagreement between where it would put the object and where the
-  carrier puts it (position and orientation) is a cost;
-* ``relaxed-position``: the fingertip's position in the object frame may
-  change at a cost;
-* ``relaxed-position-orientation``: as relaxed-position plus, as a separate
+* ``relaxed-rigidity``: each fingertip's position in the object frame may
+  change only at a cost (rolling is free), goal = object pose;
+* ``relaxed-position``: the same fingertip cost, goal = object position;
+* ``relaxed-position-orientation``: as relaxed-rigidity plus, as a separate
   term, the fingertip's orientation relative to the object;
 * ``ik-rigid``: the object follows a path interpolated from the initial to
   the goal pose and every fingertip (reference included) must keep its
