@@ -60,18 +60,22 @@ class IngraspConfig:
     w_limits: float = (
         1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
     )
-    #: ``"lbfgs"``: L-BFGS on the sum of squares (default, measured); ``"lm"``: Levenberg-Marquardt
-    #: on the residuals (opt-in, not yet measured in simulation; docs/ingrasp.md "Solver budget")
-    solver: str = "lbfgs"
-    max_iterations: int = (
-        150  #: solver iterations in all (L-BFGS iterations; LM: Jacobian evaluations)
-    )
+    #: ``"trf"``: bounded trust-region least squares on the residuals (scipy, exact Jacobian; the
+    #: default); ``"lm"``: in-house Levenberg-Marquardt; ``"lbfgs"``: L-BFGS on the sum of squares
+    #: (the default before 2026-12-02, which stopped short). docs/ingrasp.md "Solver"
+    solver: str = "trf"
+    #: initial trajectory: ``"ik"`` (joints interpolated from ``q0`` to an IK solution of the
+    #: fingertips carried rigidly to the goal) or ``"constant"`` (``q0`` at every waypoint)
+    init: str = "ik"
+    #: solver iterations in all (L-BFGS iterations; LM: Jacobian evaluations; trf: residual evaluations)
+    max_iterations: int = 150
     inner_iterations: int = (
         25  #: L-BFGS only: iterations per call; convergence is checked between calls
     )
     ftol: float = (
         1.0e-6  #: relative cost decrease of one call (L-BFGS) or iteration (LM): converged
     )
+    xtol: float = 1.0e-10  #: trf only: relative step size below which it is converged
     gtol: float = 1.0e-7  #: gradient max-norm below which the optimiser is converged
     init_noise: float = 1.0e-4  #: rad, seeded perturbation of the constant initial trajectory
     seed: int = 0  #: seed of that perturbation (torch.Generator); same seed, same trajectory
@@ -84,8 +88,10 @@ class IngraspConfig:
             raise ValueError(
                 f"object_frame must be 'reference-finger' or 'fingertips', not {self.object_frame!r}"
             )
-        if self.solver not in ("lm", "lbfgs"):
-            raise ValueError(f"solver must be 'lm' or 'lbfgs', not {self.solver!r}")
+        if self.solver not in ("trf", "lm", "lbfgs"):
+            raise ValueError(f"solver must be 'trf', 'lm' or 'lbfgs', not {self.solver!r}")
+        if self.init not in ("ik", "constant"):
+            raise ValueError(f"init must be 'ik' or 'constant', not {self.init!r}")
         if self.duration_s <= 0 or self.max_joint_speed <= 0:
             raise ValueError("duration_s and max_joint_speed must be positive")
 

@@ -21,11 +21,22 @@ kinematics. Variants differ in how the fingertips are kept on the object
   (point contact with friction: orientation free); the object pose is
   recovered afterwards by a least-squares fit of the contacts.
 
-The optimiser is L-BFGS on the weighted sum of squared residuals (gradients
-by torch autograd through the fingertip FK). Joint and per-step velocity
-limits are penalty residuals during the optimisation and are then
+Every variant's cost is a weighted sum of squared residuals, solved as the
+nonlinear least-squares problem it is: trust-region reflective
+(``scipy.optimize.least_squares``) with the exact Jacobian by forward-mode
+autodiff through the fingertip FK, joint limits as bounds, from an
+IK-interpolated initial trajectory (:func:`warm_start`). Per-step velocity
+limits are penalty residuals during the optimisation; both limits are then
 enforced exactly by projecting the trajectory (clamping waypoint by
-waypoint), so the returned trajectory always satisfies them.
+waypoint), so the returned trajectory always satisfies them. L-BFGS and an
+in-house Levenberg-Marquardt remain as opt-in solvers (``IngraspConfig.solver``).
+
+Why the warm start (measured, docs/ingrasp.md "Solver"): from ``q0`` repeated
+only the last waypoint feels the goal, and the motion has to be pushed back
+through the chain of per-step velocity limits one (penalty) hinge at a time;
+no solver we tried (L-BFGS, LM, trust region) converged from there within
+150 iterations, while from the IK-interpolated trajectory all reach the goal
+in about ten Gauss-Newton iterations.
 """
 
 from __future__ import annotations
@@ -312,6 +323,90 @@ def _levenberg_marquardt(
     return z.detach(), converged, it, f
 
 
+def _jacobian(fun, x: torch.Tensor) -> torch.Tensor:
+    """Exact Jacobian of ``fun`` at ``x`` by forward-mode autodiff through the fingertip FK."""
+    return torch.func.jacfwd(fun)(x)
+
+
+def _least_squares(
+    fun, x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, cfg: IngraspConfig
+) -> tuple[np.ndarray, bool, int, float]:
+    """Bounded nonlinear least squares (``scipy.optimize.least_squares``, trust-region reflective).
+
+    ``fun`` maps a flat torch vector to the residual vector; the Jacobian is
+    exact (:func:`_jacobian`). Variables are scaled by the Jacobian's column
+    norms (``x_scale="jac"``), so metres and radians need no hand scaling;
+    ``lower``/``upper`` are hard bounds the iterates never leave.
+    Converged: scipy stopped on ``ftol``/``xtol``/``gtol``, not ``max_iterations``.
+    """
+    from scipy.optimize import least_squares
+
+    def f(x: np.ndarray) -> np.ndarray:
+        with torch.no_grad():
+            return fun(torch.as_tensor(x, dtype=DTYPE)).numpy()
+
+    def j(x: np.ndarray) -> np.ndarray:
+        return _jacobian(fun, torch.as_tensor(x, dtype=DTYPE)).detach().numpy()
+
+    x0 = np.clip(x0, lower, upper)
+    out = least_squares(
+        f,
+        x0,
+        jac=j,
+        bounds=(lower, upper),
+        method="trf",
+        x_scale="jac",
+        ftol=cfg.ftol,
+        xtol=cfg.xtol,
+        gtol=cfg.gtol,
+        max_nfev=cfg.max_iterations,
+        # the dense sub-solver takes an SVD of the Jacobian every iteration, which multi-threaded
+        # OpenBLAS on a loaded machine made cost ~1 s (measured); lsmr only multiplies by it
+        tr_solver="lsmr",
+    )
+    return out.x, bool(out.status > 0), int(out.nfev), float(2.0 * out.cost)
+
+
+def warm_start(hand: HandKinematics, cost: _Cost, cfg: IngraspConfig) -> torch.Tensor:
+    """IK-interpolated initial trajectory (T, 4 k).
+
+    The last waypoint is inverse kinematics of the fingertip *positions* the
+    initial grasp would have if carried rigidly to the goal (bounded least
+    squares within the joint limits, a tiny pull to ``q0`` choosing among
+    the redundant solutions); the waypoints between interpolate the joints
+    linearly from ``q0`` and are then clamped onto the per-step bound. When
+    the goal is reachable by rigid motion this starts every variant near a
+    trajectory that keeps the grasp, instead of at ``q0`` repeated, from
+    which only the last waypoint feels the goal.
+    """
+    targets = (cost.goal[None] @ cost.tip_in_obj)[:, :3, 3]  # (k, 3)
+    q0 = cost.q0
+    reg = cfg.w_smooth**0.5 / cfg.w_goal_pos**0.5  # smoothness against goal, in metres
+
+    def res(q: torch.Tensor) -> torch.Tensor:
+        tips = hand.tip_poses(q[None], cost.p.fingers)[0, :, :3, 3]
+        return torch.cat([(tips - targets).reshape(-1), reg * (q - q0)])
+
+    lo, hi = cost.lo.numpy(), cost.hi.numpy()
+    q_goal, _, _, _ = _least_squares(res, q0.numpy(), lo, hi, cfg)
+    s = np.arange(1, cfg.waypoints + 1)[:, None] / cfg.waypoints
+    q0n = q0.numpy()
+    path = q0n[None] + s * (q_goal - q0n)[None]
+    return torch.as_tensor(project_trajectory(path, q0n, lo, hi, cfg.max_step), dtype=DTYPE)
+
+
+def _trust_region(
+    cost: _Cost, init: torch.Tensor, cfg: IngraspConfig
+) -> tuple[torch.Tensor, bool, int, float]:
+    """Minimise the sum of squared residuals with joint limits as bounds (:func:`_least_squares`)."""
+    lo = cost.lo[None].expand_as(init).reshape(-1).numpy()
+    hi = cost.hi[None].expand_as(init).reshape(-1).numpy()
+    x, converged, n, f = _least_squares(
+        lambda y: cost.residuals(y.reshape(init.shape)), init.reshape(-1).numpy(), lo, hi, cfg
+    )
+    return torch.as_tensor(x, dtype=DTYPE).reshape(init.shape), converged, n, f
+
+
 def plan(
     hand: HandKinematics,
     problem: InGraspProblem,
@@ -325,9 +420,12 @@ def plan(
     start = time.perf_counter()
     cost_fn = _Cost(hand, problem, variant, cfg)
     gen = torch.Generator().manual_seed(cfg.seed)
-    init = cost_fn.q0[None].repeat(cfg.waypoints, 1)
+    if cfg.init == "ik":
+        init = warm_start(hand, cost_fn, cfg)
+    else:
+        init = cost_fn.q0[None].repeat(cfg.waypoints, 1)
     init = init + cfg.init_noise * torch.randn(init.shape, generator=gen, dtype=DTYPE)
-    solve = _levenberg_marquardt if cfg.solver == "lm" else _lbfgs
+    solve = {"trf": _trust_region, "lm": _levenberg_marquardt, "lbfgs": _lbfgs}[cfg.solver]
     z, converged, iters, final_cost = solve(cost_fn, init, cfg)
     q_opt = z.detach().numpy()
     lo, hi = hand.limits(problem.fingers)
