@@ -240,10 +240,13 @@ def test_results_file_round_trips_through_score_cli(hand, tasks, tmp_path):
             for t, p in zip(rows, plans)
             if p.variant == v
         ]
-        assert g["metrics"]["err_pos"]["median"] == pytest.approx(np.median(mine), rel=1e-9)
+        # abs: the file's pose digits (~1e-13 m) matter now that converged plans miss by ~1e-5 m
+        assert g["metrics"]["err_pos"]["median"] == pytest.approx(
+            np.median(mine), rel=1e-9, abs=1e-9
+        )
         # the planned error the optimiser reports is the one the file scores
         assert np.median([p.pos_error for p in plans if p.variant == v]) * 100 == pytest.approx(
-            np.median(mine), rel=1e-6
+            np.median(mine), rel=1e-6, abs=1e-9
         )
         assert g["metrics"]["plan_time_s"]["n"] == 2
 
