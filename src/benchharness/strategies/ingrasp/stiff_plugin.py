@@ -3,8 +3,10 @@
 Why it exists: with the weights before 2026-12-02 (goal 1e6 against a pose-coupled
 rigidity 1e3) the relaxed-rigidity plans stretched the fingertip triangle by 2-4 cm
 and dropped objects. Its weights now apply to the position-only rigidity term
-(docs/ingrasp.md), where they have not been re-measured; kept until the default
-relaxed-rigidity holds in simulation on its own. Not registered by default
+(docs/ingrasp.md), where they have not been re-measured. Kept (2026-12-02): with the
+converging solver the default relaxed-rigidity executes like point-contact, but it
+still drops one trial point-contact holds and only ties its err_pos (BENCHMARKS.md,
+2026-12-02), so the default does not yet hold on its own. Not registered by default
 (so the built-in plugin list and the planning benchmark are unchanged); use
 
     benchharness run ... --strategy relaxed-rigidity-stiff --plugin benchharness.strategies.ingrasp.stiff_plugin
