@@ -416,6 +416,19 @@ def plan(
     """Optimise a joint trajectory for ``problem`` with ``variant``; deterministic for a given ``config.seed``."""
     if variant not in VARIANTS:
         raise ValueError(f"unknown variant {variant!r}; one of {', '.join(VARIANTS)}")
+    threads = torch.get_num_threads()
+    # the tensors are tiny: intra-op threads only add synchronisation, which on a loaded machine
+    # made plans 3-6x slower (2 threads vs 1, same result; docs/ingrasp.md "Solver")
+    torch.set_num_threads(1)
+    try:
+        return _plan(hand, problem, variant, config)
+    finally:
+        torch.set_num_threads(threads)
+
+
+def _plan(
+    hand: HandKinematics, problem: InGraspProblem, variant: str, config: IngraspConfig
+) -> PlanResult:
     cfg = config
     start = time.perf_counter()
     cost_fn = _Cost(hand, problem, variant, cfg)
