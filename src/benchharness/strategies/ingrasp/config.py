@@ -1,14 +1,12 @@
 """Settings of the in-grasp trajectory optimiser and the five Level I variants.
 
 Weights are per squared residual, with positions in metres and rotations in
-radians (rotation residuals are ``sin(angle) * axis``). 1 cm of position
-error weighs as much as ~5.7 deg of orientation error throughout. The goal
-weighs 1000x a fingertip's slip against the object at one waypoint: with a
-100x smaller goal weight the optimum stopped ~1 cm short of reachable goals
-(the slip cost, summed over the waypoints, wins), which is a trade-off of
-weights, not a property of the method; the benchmark measures whether the
-goal is reached, so the goal dominates and rigidity shapes *how* it is
-reached.
+radians (rotation residuals are ``sin(angle) * axis``); 1 cm of position
+weighs as much as ~5.7 deg of orientation throughout. One rule sets the
+relaxed variants' weights: a metre of fingertip slip against the object
+(per waypoint and finger) weighs as much as a metre of goal error, so the
+rigidity, summed over the waypoints and fingers, dominates the one goal term.
+The papers' own weights were not available to us (docs/ingrasp.md).
 """
 
 from __future__ import annotations
@@ -39,24 +37,45 @@ class IngraspConfig:
     #: single 4-joint finger cannot carry the object to the published goals (median 1.3 cm short
     #: at best), see docs/ingrasp.md.
     object_frame: str = "fingertips"
-    # goal (object pose at the last waypoint)
-    w_goal_pos: float = 1.0e6
-    w_goal_rot: float = 1.0e4
-    # relaxed-rigidity family: change of fingertip j against the object, per waypoint
-    w_rigid_pos: float = 1.0e3
-    w_rigid_rot: float = 1.0e1
+    # All weights multiply squared residuals in SI units (m, rad). One rule sets them: a metre of
+    # fingertip slip against the object weighs as much as a metre of object pose error, and a
+    # radian as much as 10 cm (1 cm ~ 5.7 deg). The rigidity terms are summed over the T waypoints
+    # and the fingers, the goal term is one pose: keeping the grasp outweighs the last millimetres
+    # of goal (the relaxed rigidity acts as the near-constraint its name says). docs/ingrasp.md.
+    #: the goal cost at every waypoint (True) or at the last only (False, default): every waypoint
+    #: pulled to an unreachable-yet goal stretches the grasp (measured, docs/ingrasp.md)
+    goal_every_waypoint: bool = False
+    w_goal_pos: float = 1.0e4  #: object position at the last waypoint vs goal (m^2)
+    w_goal_rot: float = 1.0e2  #: object orientation at the last waypoint vs goal (rad^2)
+    #: relaxed rigidity: fingertip position in the object frame vs its initial one, per waypoint and finger
+    w_rigid_pos: float = 1.0e4
+    #: relaxed-position-orientation only: fingertip orientation relative to the object, likewise
+    w_rigid_rot: float = 1.0e2
     # object-path variants: fingertip targets on the interpolated object path ("constraints")
-    w_contact_pos: float = 1.0e5
-    w_contact_rot: float = 1.0e3
-    w_smooth: float = 1.0e-1  #: sum of squared joint steps (rad^2)
+    w_contact_pos: float = 1.0e6
+    w_contact_rot: float = 1.0e4
+    #: joint-velocity smoothness, sum of squared joint steps (rad^2): a 0.1 rad step weighs as much
+    #: as 0.1 mm of goal error, so it only chooses among trajectories that keep the grasp equally well
+    w_smooth: float = 1.0e-2
     w_limits: float = (
         1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
     )
-    max_iterations: int = 150  #: L-BFGS iterations in all (the planning-time budget)
-    inner_iterations: int = 25  #: per L-BFGS call; convergence is checked between calls
-    ftol: float = (
-        1.0e-6  #: relative cost decrease over one call below which the optimiser is converged
+    #: ``"trf"``: bounded trust-region least squares on the residuals (scipy, exact Jacobian; the
+    #: default); ``"lm"``: in-house Levenberg-Marquardt; ``"lbfgs"``: L-BFGS on the sum of squares
+    #: (the default before 2026-12-02, which stopped short). docs/ingrasp.md "Solver"
+    solver: str = "trf"
+    #: initial trajectory: ``"ik"`` (joints interpolated from ``q0`` to an IK solution of the
+    #: fingertips carried rigidly to the goal) or ``"constant"`` (``q0`` at every waypoint)
+    init: str = "ik"
+    #: solver iterations in all (L-BFGS iterations; LM: Jacobian evaluations; trf: residual evaluations)
+    max_iterations: int = 150
+    inner_iterations: int = (
+        25  #: L-BFGS only: iterations per call; convergence is checked between calls
     )
+    ftol: float = (
+        1.0e-6  #: relative cost decrease of one call (L-BFGS) or iteration (LM): converged
+    )
+    xtol: float = 1.0e-10  #: trf only: relative step size below which it is converged
     gtol: float = 1.0e-7  #: gradient max-norm below which the optimiser is converged
     init_noise: float = 1.0e-4  #: rad, seeded perturbation of the constant initial trajectory
     seed: int = 0  #: seed of that perturbation (torch.Generator); same seed, same trajectory
@@ -69,6 +88,10 @@ class IngraspConfig:
             raise ValueError(
                 f"object_frame must be 'reference-finger' or 'fingertips', not {self.object_frame!r}"
             )
+        if self.solver not in ("trf", "lm", "lbfgs"):
+            raise ValueError(f"solver must be 'trf', 'lm' or 'lbfgs', not {self.solver!r}")
+        if self.init not in ("ik", "constant"):
+            raise ValueError(f"init must be 'ik' or 'constant', not {self.init!r}")
         if self.duration_s <= 0 or self.max_joint_speed <= 0:
             raise ValueError("duration_s and max_joint_speed must be positive")
 

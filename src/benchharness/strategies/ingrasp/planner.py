@@ -8,12 +8,10 @@ fixes the offset), so the object pose at every waypoint is forward
 kinematics. Variants differ in how the fingertips are kept on the object
 (see ``docs/ingrasp.md``):
 
-* ``relaxed-rigidity``: each fingertip is modelled as rigidly attached too,
-  and the disagreement between where it would put the object and where the
-  carrier puts it (position and orientation) is a cost;
-* ``relaxed-position``: the fingertip's position in the object frame may
-  change at a cost;
-* ``relaxed-position-orientation``: as relaxed-position plus, as a separate
+* ``relaxed-rigidity``: each fingertip's position in the object frame may
+  change only at a cost (rolling is free), goal = object pose;
+* ``relaxed-position``: the same fingertip cost, goal = object position;
+* ``relaxed-position-orientation``: as relaxed-rigidity plus, as a separate
   term, the fingertip's orientation relative to the object;
 * ``ik-rigid``: the object follows a path interpolated from the initial to
   the goal pose and every fingertip (reference included) must keep its
@@ -23,11 +21,22 @@ kinematics. Variants differ in how the fingertips are kept on the object
   (point contact with friction: orientation free); the object pose is
   recovered afterwards by a least-squares fit of the contacts.
 
-The optimiser is L-BFGS on the weighted sum of squared residuals (gradients
-by torch autograd through the fingertip FK). Joint and per-step velocity
-limits are penalty residuals during the optimisation and are then
+Every variant's cost is a weighted sum of squared residuals, solved as the
+nonlinear least-squares problem it is: trust-region reflective
+(``scipy.optimize.least_squares``) with the exact Jacobian by forward-mode
+autodiff through the fingertip FK, joint limits as bounds, from an
+IK-interpolated initial trajectory (:func:`warm_start`). Per-step velocity
+limits are penalty residuals during the optimisation; both limits are then
 enforced exactly by projecting the trajectory (clamping waypoint by
-waypoint), so the returned trajectory always satisfies them.
+waypoint), so the returned trajectory always satisfies them. L-BFGS and an
+in-house Levenberg-Marquardt remain as opt-in solvers (``IngraspConfig.solver``).
+
+Why the warm start (measured, docs/ingrasp.md "Solver"): from ``q0`` repeated
+only the last waypoint feels the goal, and the motion has to be pushed back
+through the chain of per-step velocity limits one (penalty) hinge at a time;
+no solver we tried (L-BFGS, LM, trust region) converged from there within
+150 iterations, while from the IK-interpolated trajectory all reach the goal
+in about ten Gauss-Newton iterations.
 """
 
 from __future__ import annotations
@@ -153,11 +162,30 @@ class _Cost:
         )  # object in its carrier frame
         rel = inverse(self.x_o0)[None] @ x0  # fingertips in the object frame (k, 4, 4)
         self.tip_in_obj = rel
-        self.obj_in_tip = inverse(x0) @ self.x_o0[None]  # object in each fingertip frame
         if variant in OBJECT_PATH:
             s = np.arange(1, cfg.waypoints + 1) / cfg.waypoints
             path = interpolate_poses(problem.object_initial, problem.goal, s)  # (T, 4, 4)
             self.targets = t(path)[:, None] @ rel[None]  # (T, k, 4, 4)
+
+    def rigidity_residuals(
+        self, x: torch.Tensor, x_o: torch.Tensor, first: int = 0
+    ) -> list[torch.Tensor]:
+        """Relaxed-rigidity residuals: each fingertip's pose in the object frame against its initial one.
+
+        ``x`` (T, k, 4, 4) fingertip poses, ``x_o`` (T, 4, 4) object poses, both in
+        the palm frame. Position residuals (m) for every finger from ``first``
+        on, weighted ``w_rigid_pos``; for relaxed-position-orientation also the
+        fingertip's orientation relative to the object (``w_rigid_rot``). Zero
+        for any trajectory that moves fingertips and object as one rigid body.
+        """
+        cfg = self.cfg
+        in_obj = inverse(x_o)[:, None] @ x[:, first:]  # fingertips in the object frame now
+        ref = self.tip_in_obj[None, first:]
+        out = [(cfg.w_rigid_pos**0.5) * (in_obj[..., :3, 3] - ref[..., :3, 3]).reshape(-1)]
+        if self.variant == "relaxed-position-orientation":
+            r = rot_residual(ref[..., :3, :3], in_obj[..., :3, :3])
+            out.append((cfg.w_rigid_rot**0.5) * r.reshape(-1))
+        return out
 
     def residuals(self, q: torch.Tensor) -> torch.Tensor:
         """All weighted residuals as one vector; the cost is its squared norm (a least-squares problem)."""
@@ -167,35 +195,17 @@ class _Cost:
         parts = []
         if v in RELAXED:
             x_o = carrier_frames(x, cfg.object_frame) @ self.attach  # (T, 4, 4)
-            first = (
-                1 if cfg.object_frame == "reference-finger" else 0
-            )  # the carrier finger cannot slip
-            others = x[:, first:]
-            if v == "relaxed-rigidity":
-                pred = (
-                    others @ self.obj_in_tip[None, first:]
-                )  # object as each fingertip would carry it
-                parts.append(sq(cfg.w_rigid_pos, pred[..., :3, 3] - x_o[:, None, :3, 3]))
+            # the carrier finger (reference-finger model) is the object's frame: it cannot slip
+            first = 1 if cfg.object_frame == "reference-finger" else 0
+            parts.extend(self.rigidity_residuals(x, x_o, first))
+            # the object pose cost at every waypoint (not only the last): each waypoint is pulled
+            # towards the goal as far as the velocity limit lets it
+            xs = x_o if cfg.goal_every_waypoint else x_o[-1:]
+            parts.append(sq(cfg.w_goal_pos, xs[:, :3, 3] - self.goal[None, :3, 3]))
+            if v != "relaxed-position":  # relaxed-position: the object's position is the goal
                 parts.append(
-                    sq(cfg.w_rigid_rot, rot_residual(x_o[:, None, :3, :3], pred[..., :3, :3]))
+                    sq(cfg.w_goal_rot, rot_residual(self.goal[None, :3, :3], xs[:, :3, :3]))
                 )
-            else:
-                in_obj = inverse(x_o)[:, None] @ others  # fingertips in the object frame now
-                parts.append(
-                    sq(cfg.w_rigid_pos, in_obj[..., :3, 3] - self.tip_in_obj[None, first:, :3, 3])
-                )
-                if v == "relaxed-position-orientation":
-                    parts.append(
-                        sq(
-                            cfg.w_rigid_rot,
-                            rot_residual(
-                                self.tip_in_obj[None, first:, :3, :3], in_obj[..., :3, :3]
-                            ),
-                        )
-                    )
-            xf = x_o[-1]
-            parts.append(sq(cfg.w_goal_pos, xf[:3, 3] - self.goal[:3, 3]))
-            parts.append(sq(cfg.w_goal_rot, rot_residual(self.goal[:3, :3], xf[:3, :3])))
         else:
             parts.append(sq(cfg.w_contact_pos, x[..., :3, 3] - self.targets[..., :3, 3]))
             if v == "ik-rigid":
@@ -258,6 +268,145 @@ def _lbfgs(
     return z.detach(), converged, iters, final
 
 
+def _levenberg_marquardt(
+    cost: _Cost, init: torch.Tensor, cfg: IngraspConfig
+) -> tuple[torch.Tensor, bool, int, float]:
+    """Minimise the sum of squared residuals from ``init`` with Levenberg-Marquardt.
+
+    The cost is a least-squares problem (:meth:`_Cost.residuals`); its
+    Jacobian comes from forward-mode autodiff (``torch.func.jacfwd``) through
+    the fingertip FK. Gauss-Newton steps are insensitive to how stiff the
+    weights make the problem (rigidity summed over every waypoint against one
+    goal term), where a gradient method needs thousands of iterations.
+    Converged: a step lowered the cost by less than ``ftol`` (relative), or the
+    gradient is below ``gtol``; not converged: ``max_iterations`` spent or the
+    damping ran away.
+    """
+    z = init.clone()
+    n = z.numel()
+
+    def res(y: torch.Tensor) -> torch.Tensor:
+        return cost.residuals(y.reshape(z.shape))
+
+    r = res(z.reshape(-1))
+    f = float(r @ r)
+    lam, converged, it = 1.0e-3, False, 0
+    eye = torch.eye(n, dtype=DTYPE)
+    while it < cfg.max_iterations:
+        it += 1
+        jac = torch.func.jacfwd(res)(z.reshape(-1))  # (m, n)
+        g = jac.T @ r
+        if float(g.abs().max()) <= cfg.gtol:
+            converged = True
+            break
+        h = jac.T @ jac
+        d = torch.diagonal(h).clamp_min(1.0e-12)
+        accepted = False
+        while lam < 1.0e12:
+            step = torch.linalg.solve(h + lam * torch.diag(d) + 1.0e-12 * eye, -g)
+            z_new = z + step.reshape(z.shape)
+            r_new = res(z_new.reshape(-1))
+            f_new = float(r_new @ r_new)
+            if f_new < f:
+                accepted = True
+                break
+            lam *= 4.0
+        if not accepted:  # no descent left at any damping: a (numerical) minimum
+            converged = True
+            break
+        decrease = f - f_new
+        z, r, f = z_new, r_new, f_new
+        lam = max(lam / 3.0, 1.0e-9)
+        if decrease <= cfg.ftol * max(1.0, f):
+            converged = True
+            break
+    return z.detach(), converged, it, f
+
+
+def _jacobian(fun, x: torch.Tensor) -> torch.Tensor:
+    """Exact Jacobian of ``fun`` at ``x`` by forward-mode autodiff through the fingertip FK."""
+    return torch.func.jacfwd(fun)(x)
+
+
+def _least_squares(
+    fun, x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, cfg: IngraspConfig
+) -> tuple[np.ndarray, bool, int, float]:
+    """Bounded nonlinear least squares (``scipy.optimize.least_squares``, trust-region reflective).
+
+    ``fun`` maps a flat torch vector to the residual vector; the Jacobian is
+    exact (:func:`_jacobian`). Variables are scaled by the Jacobian's column
+    norms (``x_scale="jac"``), so metres and radians need no hand scaling;
+    ``lower``/``upper`` are hard bounds the iterates never leave.
+    Converged: scipy stopped on ``ftol``/``xtol``/``gtol``, not ``max_iterations``.
+    """
+    from scipy.optimize import least_squares
+
+    def f(x: np.ndarray) -> np.ndarray:
+        with torch.no_grad():
+            return fun(torch.as_tensor(x, dtype=DTYPE)).numpy()
+
+    def j(x: np.ndarray) -> np.ndarray:
+        return _jacobian(fun, torch.as_tensor(x, dtype=DTYPE)).detach().numpy()
+
+    x0 = np.clip(x0, lower, upper)
+    out = least_squares(
+        f,
+        x0,
+        jac=j,
+        bounds=(lower, upper),
+        method="trf",
+        x_scale="jac",
+        ftol=cfg.ftol,
+        xtol=cfg.xtol,
+        gtol=cfg.gtol,
+        max_nfev=cfg.max_iterations,
+        # the dense sub-solver takes an SVD of the Jacobian every iteration, which multi-threaded
+        # OpenBLAS on a loaded machine made cost ~1 s (measured); lsmr only multiplies by it
+        tr_solver="lsmr",
+    )
+    return out.x, bool(out.status > 0), int(out.nfev), float(2.0 * out.cost)
+
+
+def warm_start(hand: HandKinematics, cost: _Cost, cfg: IngraspConfig) -> torch.Tensor:
+    """IK-interpolated initial trajectory (T, 4 k).
+
+    The last waypoint is inverse kinematics of the fingertip *positions* the
+    initial grasp would have if carried rigidly to the goal (bounded least
+    squares within the joint limits, a tiny pull to ``q0`` choosing among
+    the redundant solutions); the waypoints between interpolate the joints
+    linearly from ``q0`` and are then clamped onto the per-step bound. When
+    the goal is reachable by rigid motion this starts every variant near a
+    trajectory that keeps the grasp, instead of at ``q0`` repeated, from
+    which only the last waypoint feels the goal.
+    """
+    targets = (cost.goal[None] @ cost.tip_in_obj)[:, :3, 3]  # (k, 3)
+    q0 = cost.q0
+    reg = cfg.w_smooth**0.5 / cfg.w_goal_pos**0.5  # smoothness against goal, in metres
+
+    def res(q: torch.Tensor) -> torch.Tensor:
+        tips = hand.tip_poses(q[None], cost.p.fingers)[0, :, :3, 3]
+        return torch.cat([(tips - targets).reshape(-1), reg * (q - q0)])
+
+    lo, hi = cost.lo.numpy(), cost.hi.numpy()
+    q_goal, _, _, _ = _least_squares(res, q0.numpy(), lo, hi, cfg)
+    s = np.arange(1, cfg.waypoints + 1)[:, None] / cfg.waypoints
+    q0n = q0.numpy()
+    path = q0n[None] + s * (q_goal - q0n)[None]
+    return torch.as_tensor(project_trajectory(path, q0n, lo, hi, cfg.max_step), dtype=DTYPE)
+
+
+def _trust_region(
+    cost: _Cost, init: torch.Tensor, cfg: IngraspConfig
+) -> tuple[torch.Tensor, bool, int, float]:
+    """Minimise the sum of squared residuals with joint limits as bounds (:func:`_least_squares`)."""
+    lo = cost.lo[None].expand_as(init).reshape(-1).numpy()
+    hi = cost.hi[None].expand_as(init).reshape(-1).numpy()
+    x, converged, n, f = _least_squares(
+        lambda y: cost.residuals(y.reshape(init.shape)), init.reshape(-1).numpy(), lo, hi, cfg
+    )
+    return torch.as_tensor(x, dtype=DTYPE).reshape(init.shape), converged, n, f
+
+
 def plan(
     hand: HandKinematics,
     problem: InGraspProblem,
@@ -267,13 +416,30 @@ def plan(
     """Optimise a joint trajectory for ``problem`` with ``variant``; deterministic for a given ``config.seed``."""
     if variant not in VARIANTS:
         raise ValueError(f"unknown variant {variant!r}; one of {', '.join(VARIANTS)}")
+    threads = torch.get_num_threads()
+    # the tensors are tiny: intra-op threads only add synchronisation, which on a loaded machine
+    # made plans 3-6x slower (2 threads vs 1, same result; docs/ingrasp.md "Solver")
+    torch.set_num_threads(1)
+    try:
+        return _plan(hand, problem, variant, config)
+    finally:
+        torch.set_num_threads(threads)
+
+
+def _plan(
+    hand: HandKinematics, problem: InGraspProblem, variant: str, config: IngraspConfig
+) -> PlanResult:
     cfg = config
     start = time.perf_counter()
     cost_fn = _Cost(hand, problem, variant, cfg)
     gen = torch.Generator().manual_seed(cfg.seed)
-    init = cost_fn.q0[None].repeat(cfg.waypoints, 1)
+    if cfg.init == "ik":
+        init = warm_start(hand, cost_fn, cfg)
+    else:
+        init = cost_fn.q0[None].repeat(cfg.waypoints, 1)
     init = init + cfg.init_noise * torch.randn(init.shape, generator=gen, dtype=DTYPE)
-    z, converged, iters, final_cost = _lbfgs(cost_fn, init, cfg)
+    solve = {"trf": _trust_region, "lm": _levenberg_marquardt, "lbfgs": _lbfgs}[cfg.solver]
+    z, converged, iters, final_cost = solve(cost_fn, init, cfg)
     q_opt = z.detach().numpy()
     lo, hi = hand.limits(problem.fingers)
     q_proj = project_trajectory(

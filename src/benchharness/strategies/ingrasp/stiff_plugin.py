@@ -1,11 +1,12 @@
 """Opt-in plugin: relaxed-rigidity with 100x stiffer rigidity weights (``relaxed-rigidity-stiff``).
 
-Why it exists: with the default weights (goal 1e6 against rigidity 1e3)
-the relaxed-rigidity plans reach the published goals by stretching the
-fingertip triangle by 2-4 cm, which no rigid object survives in simulation
-(``docs/benchmarks/inhand_sim.md``). With ``w_rigid_pos = 1e5`` and
-``w_rigid_rot = 1e3`` the triangle changes by a few millimetres and the plan
-still ends within a few millimetres of the goal. Not registered by default
+Why it exists: with the weights before 2026-12-02 (goal 1e6 against a pose-coupled
+rigidity 1e3) the relaxed-rigidity plans stretched the fingertip triangle by 2-4 cm
+and dropped objects. Its weights now apply to the position-only rigidity term
+(docs/ingrasp.md), where they have not been re-measured. Kept (2026-12-02): with the
+converging solver the default relaxed-rigidity executes like point-contact, but it
+still drops one trial point-contact holds and only ties its err_pos (BENCHMARKS.md,
+2026-12-02), so the default does not yet hold on its own. Not registered by default
 (so the built-in plugin list and the planning benchmark are unchanged); use
 
     benchharness run ... --strategy relaxed-rigidity-stiff --plugin benchharness.strategies.ingrasp.stiff_plugin
