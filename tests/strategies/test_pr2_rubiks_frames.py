@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from benchharness.geometry import Pose
 from benchharness.strategies.pr2_rubiks.config import ErrorConfig, PR2RubiksConfig
-from benchharness.strategies.pr2_rubiks.frames import (
+from benchharness.strategies.bimanual.frames import (
     body_axis_along,
     grip_candidates,
     grip_pose,
