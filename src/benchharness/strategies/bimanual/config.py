@@ -46,6 +46,9 @@ class BimanualConfig:
     #: this many degrees apart (:meth:`.machine.BimanualRubiksMachine._swing`): one joint-space move from
     #: one side of the cube to another sweeps the hand along whatever path the joints take.
     swing_step_deg: float = 45.0
+    #: a hand whose stand-off is less than this many degrees round the cube from where it is moves straight
+    #: there (so does one within one ``swing_step_deg``). 0: only the step decides.
+    swing_min_deg: float = 0.0
     #: only a hand whose tool frame starts nearer the believed cube centre than this (m) swings round it;
     #: one farther away (an arm out at its side) moves straight to its stand-off. inf: every hand swings.
     swing_radius: float = float("inf")

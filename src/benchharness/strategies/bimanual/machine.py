@@ -466,7 +466,14 @@ class BimanualRubiksMachine:
         )
 
     def turn_travel(
-        self, hand: Hand, base: Pose, grips: list[Pose], q: np.ndarray, axis: str, angle: float
+        self,
+        hand: Hand,
+        base: Pose,
+        grips: list[Pose],
+        q: np.ndarray,
+        axis: str,
+        angle: float,
+        with_retreat: bool = True,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Joint travel of carrying the cube from each of ``grips`` through the hand-over turn (inf: not
         smooth), and the largest joint step on the way (inf: a waypoint out of reach).
@@ -475,13 +482,14 @@ class BimanualRubiksMachine:
         call per waypoint, each seeded with its own previous solution. The chain ends with the giver's
         retreat from the turned grip (``handover_retreat`` back along its approach): a turn that ends
         at a joint limit leaves no straight way out, and the arm's retreat then swings through the cube.
+        ``with_retreat=False``: the turn's waypoints only (a robot's fallback when no grip passes).
         """
         cfg = self.config
         n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
         q = np.array(q, dtype=float)
         total = np.zeros(len(grips))
         worst = np.zeros(len(grips))
-        for i in range(1, n + 2):
+        for i in range(1, n + 2 if with_retreat else n + 1):
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
@@ -513,7 +521,8 @@ class BimanualRubiksMachine:
         the centre and its orientation interpolated between the two ends, so
         it never comes nearer the cube than where it started or ends. A
         waypoint the arm cannot reach is left out. A hand farther than
-        ``swing_radius`` from the cube moves straight to the stand-off.
+        ``swing_radius`` from the cube, or whose stand-off is less than
+        ``swing_min_deg`` round it, moves straight to the stand-off.
         """
         from scipy.spatial.transform import Slerp
 
@@ -524,7 +533,13 @@ class BimanualRubiksMachine:
         u0, u1 = d0 / max(r0, 1e-9), d1 / max(r1, 1e-9)
         angle = math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))
         n = max(1, math.ceil(angle / math.radians(cfg.swing_step_deg)))
-        if n == 1 or r0 < 0.05 or r1 < 0.05 or r0 > cfg.swing_radius:
+        if (
+            n == 1
+            or r0 < 0.05
+            or r1 < 0.05
+            or r0 > cfg.swing_radius
+            or math.degrees(angle) < cfg.swing_min_deg
+        ):
             self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
             return
         axis = np.cross(u0, u1)

@@ -102,6 +102,11 @@ class HerbPushGraspConfig(BimanualConfig):
     #: machine's swing): one joint-space move from beside the cube to behind it swept the re-gripping hand
     #: through the taker's thumb and the cube fell (measured, SAPIEN).
     swing_step_deg: float = 20.0
+    #: and only when its stand-off is at least two steps round the cube, the rule HERB's trials were measured
+    #: with: from its home pose the second grasp's stand-off is 39 deg round, and a two-waypoint arc there
+    #: moved where that grasp landed (0.6 mm) until Rubiks-1-5's first hand-over take found no grip whose
+    #: fingers clear the giver's (SAPIEN, seed 0; the take had slid to its 20 mm limit before).
+    swing_min_deg: float = 40.0
     #: only a hand whose tool frame is nearer the cube than this (m) swings round it; one farther away
     #: (e.g. an arm far out at its side before the pick) moves straight to its stand-off.
     swing_radius: float = 0.30

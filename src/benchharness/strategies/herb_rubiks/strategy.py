@@ -138,8 +138,9 @@ class PushGrasp:
         hand-over take, see ``taker_parallel``); None: crossing is preferred. ``req.on_table``: no
         finger may go under the cube, and the thumb comes from below (its root beside the table).
         ``req.turn``: this hand will give the cube in a hand-over, so the grip should let the arm
-        carry that turn (and the retreat after it) without an IK flip
-        (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`).
+        carry that turn and the retreat after it without an IK flip
+        (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`); if no grip does, one whose
+        turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not).
         Returns no IK solution: the arm moves to the stand-off from where it is.
         """
         cfg = self.config
@@ -158,9 +159,12 @@ class PushGrasp:
         q_now = hand.arm.positions()
         lo, hi = hand.arm.lower[-1], hand.arm.upper[-1]
         best: Pose | None = None
+        second: Pose | None = (
+            None  # a giver's grip whose turn is smooth but not the retreat after it
+        )
         fallback: Pose | None = None
-        best_score = fallback_score = -np.inf
-        best_slide = fallback_slide = 0.0
+        best_score = second_score = fallback_score = -np.inf
+        best_slide = second_slide = fallback_slide = 0.0
         # diagnostic for the recorder: each candidate and why it was taken or not
         tried: list[str] = []
         lateral = cfg.rotator_thumb_offset if st.shape == 1 else cfg.holder_thumb_offset
@@ -223,10 +227,20 @@ class PushGrasp:
                     fallback, fallback_score, fallback_slide = pose, score, shift - lateral
                 travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
                 if not np.isfinite(travel[0]):
-                    tried.append(
-                        f"{tag}: turn not smooth (score {score:.2f}; largest joint step "
-                        f"{float(worst[0]):.2f} rad)"
+                    # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
+                    # turn alone is smooth is the second choice (the retreat is then cut short)
+                    short, _ = m.turn_travel(
+                        hand, base, [pose], res.q[:1], *turn, with_retreat=False
                     )
+                    tried.append(
+                        f"{tag}: turn + retreat not smooth (score {score:.2f}; largest joint step "
+                        f"{float(worst[0]):.2f} rad; turn alone "
+                        f"{'smooth' if np.isfinite(short[0]) else 'not smooth'})"
+                    )
+                    if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
+                        second = pose
+                        second_score = score - 0.1 * float(short[0])
+                        second_slide = shift - lateral
                     continue
                 score -= 0.1 * float(travel[0])
             tried.append(
@@ -234,6 +248,12 @@ class PushGrasp:
             )
             if score > best_score:
                 best, best_score, best_slide = pose, score, shift - lateral
+        if best is None and second is not None:
+            m.ctx.recorder.event(
+                "warning",
+                message=f"{hand.side}: no grip lets the giver retreat straight after the hand-over turn",
+            )
+            best, best_slide = second, second_slide
         if best is None and fallback is not None:
             m.ctx.recorder.event(
                 "warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly"
