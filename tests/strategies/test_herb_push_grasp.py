@@ -30,7 +30,8 @@ def test_registered_for_herb_and_refuses_other_robots(make_ctx):
     m = get_manager()
     for name in ("push-grasp", "push-grasp-exact"):
         strat = m.create("strategy", name)
-        assert strat.name == "push-grasp" and "rubiks" in strat.benchmarks and strat.robot == "herb"
+        assert strat.name == "push-grasp" and "rubiks" in strat.benchmarks
+        assert strat.grasp.robot_name == "herb"
     assert m.create("strategy", "push-grasp-exact").config.errors.is_zero
     ctx, _ = make_ctx("pybullet", "R")  # the fixture's robot is the PR2
     with pytest.raises(ValueError, match="herb"):

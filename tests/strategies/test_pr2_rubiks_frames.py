@@ -9,14 +9,14 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from benchharness.geometry import Pose
-from benchharness.strategies.pr2_rubiks.config import ErrorConfig, PR2RubiksConfig
-from benchharness.strategies.pr2_rubiks.frames import (
+from benchharness.strategies.bimanual.frames import (
     body_axis_along,
     grip_candidates,
     grip_pose,
     rotate_about_point,
     turned_about_approach,
 )
+from benchharness.strategies.pr2_rubiks.config import ErrorConfig, PR2RubiksConfig
 
 #: the cube as the protocol puts it on the table: U up, F (body -y) facing the robot (world -x)
 TABLE_YAW = Rotation.from_euler("z", -90, degrees=True)

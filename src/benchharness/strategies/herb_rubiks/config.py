@@ -1,6 +1,7 @@
 """Parameters of HERB's push-grasp Rubik's strategy: scene, hand pre-shapes, the push, and every error source.
 
-Every magnitude is a named field with its default and why. ``zero_error()``
+Every magnitude is a named field with its default and why; the fields every
+robot has come from :class:`..bimanual.config.BimanualConfig`. ``zero_error()``
 gives the same configuration with every injected error 0 (tests, and telling
 the strategy's own mistakes from injected ones).
 """
@@ -8,15 +9,16 @@ the strategy's own mistakes from injected ones).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
+from ..bimanual.config import BimanualConfig
 from ..error_sources import ErrorConfig
 
 __all__ = ["ErrorConfig", "HerbPushGraspConfig"]
 
 
-@dataclass(frozen=True)
-class HerbPushGraspConfig:
+@dataclass(frozen=True, kw_only=True)
+class HerbPushGraspConfig(BimanualConfig):
     """Scene, pre-shapes, push and motion settings (metres, seconds, radians, newtons)."""
 
     #: table top height (m): the cube's middle at 0.9285 m, level with the WAM shoulders (j1 at
@@ -96,34 +98,26 @@ class HerbPushGraspConfig:
     grip_torque: float = 2.0
     #: closing speed of the outer fingers' command (rad/s).
     finger_speed: float = 1.5
-    #: stand-off the arm swings round at before a push (m), along the approach from the believed contact.
-    far_distance: float = 0.15
-    #: a free hand swings round the cube to its stand-off while the other holds it alone on an arc about
-    #: the cube, in joint-space moves of at most this many degrees: one joint-space move from beside the cube
-    #: to behind it swept the re-gripping hand through the taker's thumb and the cube fell (measured, SAPIEN).
+    #: a free hand swings round the cube in Cartesian waypoints at most this many degrees apart (the
+    #: machine's swing): one joint-space move from beside the cube to behind it swept the re-gripping hand
+    #: through the taker's thumb and the cube fell (measured, SAPIEN).
     swing_step_deg: float = 20.0
+    #: and only when its stand-off is at least two steps round the cube, the rule HERB's trials were measured
+    #: with: from its home pose the second grasp's stand-off is 39 deg round, and a two-waypoint arc there
+    #: moved where that grasp landed (0.6 mm) until Rubiks-1-5's first hand-over take found no grip whose
+    #: fingers clear the giver's (SAPIEN, seed 0; the take had slid to its 20 mm limit before).
+    swing_min_deg: float = 40.0
     #: only a hand whose tool frame is nearer the cube than this (m) swings round it; one farther away
-    #: (e.g. an arm far out at its side) moves straight to its stand-off as before.
+    #: (e.g. an arm far out at its side before the pick) moves straight to its stand-off.
     swing_radius: float = 0.30
-    #: largest joint change (rad) between two swing waypoints (bigger = IK flipped the arm, which would sweep).
-    swing_max_joint_step: float = 1.5
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
-    #: duration of one quarter turn of the wrist (WAM joint 7) (s).
-    quarter_turn_s: float = 1.0
-    #: joint-speed fraction for arm motions.
-    velocity_scale: float = 0.4
-    #: waypoints per quarter turn when the giver turns the cube in a hand-over.
-    handover_waypoints: int = 4
+    #: the picker and a hand-over's taker grip at the depth they hold next (one slab if they rotate next),
+    #: as HERB's trials were measured with (docs/herb_push_grasp.md): it saves a push-grasp and a release per
+    #: pick and hand-over, and every push shoves the held cube (5.2 mm measured on PyBullet). Whether the
+    #: PR2's two-slab lone grip (True) helps a push-grasp has not been measured.
+    lone_holder_two_slabs: bool = False
     #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).
     max_waypoint_jump: float = 2.5
     #: a motion that ends farther than this from its target is logged as a warning event (m).
-    reach_warning: float = 0.005
-    #: the cube counts as dropped if it ends below the table top + 1 cm and this far from the belief (m).
-    drop_distance: float = 0.05
-    #: stop after this many plan actions (None: the whole plan); for tests and debugging.
-    max_actions: int | None = None
-    errors: ErrorConfig = ErrorConfig()
-
-    def zero_error(self) -> HerbPushGraspConfig:
-        return replace(self, errors=self.errors.zero())
+    reach_warning: float | None = 0.005

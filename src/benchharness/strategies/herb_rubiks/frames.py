@@ -2,8 +2,8 @@
 
 HERB's tool frame ``{l,r}_bh_tcp`` has z = approach (out of the palm) and
 y towards the thumb (F3); with the spread at 90 deg the outer fingers F1/F2
-face each other across tool x. The PR2 baselines' frames
-(:mod:`benchharness.strategies.pr2_rubiks.frames`) are robot-independent
+face each other across tool x. The machine's grip frames
+(:mod:`benchharness.strategies.bimanual.frames`) are robot-independent
 grip geometry with x = approach and y = the finger axis, so a HERB grip is
 that frame turned by :data:`HERB_FROM_PR2`: HERB z = PR2 x (approach),
 HERB x = PR2 y (the pinch axis), HERB y = PR2 z.
@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
 from ...robots.descriptions.herb import DIST_BOX, PROX_BOX
-from ..pr2_rubiks.frames import DIRECTIONS, grip_candidates, rotate_about_point
+from ..bimanual.frames import DIRECTIONS, grip_candidates, rotate_about_point
 
 __all__ = [
     "CUBE_HALF",

@@ -8,8 +8,10 @@
   calibration, tracking noise, camera noise) set to zero: a diagnostic that
   separates the strategy's own mistakes from the benchmark's error sources.
 
-Modules: :mod:`.config` (parameters), :mod:`.frames` (targets from an
-estimated pose, no physics), :mod:`.strategy` (the trial). See docs/strategies.md.
+Both run on the bimanual state machine (:mod:`..bimanual.machine`) with the
+PR2's grasp module. Modules: :mod:`.config` (parameters), :mod:`.strategy`
+(the grasp modules and the strategies), :mod:`.workspace` (the IK scan that
+placed the twisting pose). See docs/strategies.md.
 Heavy imports (torch, engines) happen only inside the factories' products.
 """
 

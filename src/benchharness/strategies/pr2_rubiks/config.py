@@ -1,17 +1,19 @@
 """Parameters of the PR2 Rubik's baselines: scene, grasp geometry and every error source.
 
 Every magnitude is a named field with its default and why (docs/strategies.md,
-"Error sources"). ``zero_error()`` gives the same
+"Error sources"); the fields every robot has come from
+:class:`..bimanual.config.BimanualConfig`. ``zero_error()`` gives the same
 configuration with every injected error set to 0 (for tests and for telling
 the strategy's own mistakes from injected ones).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from ...cube_physics.config import CubeConfig
 from ...robots.descriptions.pr2 import PAD_SIZE, pad_setback
+from ..bimanual.config import BimanualConfig
 from ..error_sources import ErrorConfig
 
 __all__ = ["ErrorConfig", "PR2RubiksConfig", "grip_offset"]
@@ -27,9 +29,13 @@ def grip_offset(inner_end: float, edge: float = CubeConfig().edge) -> float:
     return inner_end + PAD_SIZE[0] / 2 - pad_setback(edge)
 
 
-@dataclass(frozen=True)
-class PR2RubiksConfig:
-    """Scene, grasp geometry and motion settings of the PR2 baselines (metres, seconds)."""
+@dataclass(frozen=True, kw_only=True)
+class PR2RubiksConfig(BimanualConfig):
+    """Scene, grasp geometry and motion settings of the PR2 baselines (metres, seconds).
+
+    The fields every robot has are :class:`..bimanual.config.BimanualConfig`'s
+    (documented there); the PR2's values of the scene's are explained here.
+    """
 
     #: height of the table top (m): 7 cm below the twisting pose's cube bottom, so that the pick is
     #: a straight lift (the cube centre on the table at 0.5285 m) and no finger reaches the table
@@ -57,9 +63,8 @@ class PR2RubiksConfig:
     holder_offset: float = grip_offset(0.0)
     #: stand-off of the pre-grasp pose along the approach (m).
     pregrasp_distance: float = 0.07
-    #: stand-off the arm swings round at before a pre-grasp (m): the fingers open to 90 mm and a
-    #: swing of the wrist at 7 cm can sweep the 57 mm cube.
-    far_distance: float = 0.15
+    #: a hand that lets go backs off to the pre-grasp stand-off (m), the way it came in.
+    retreat_distance: float = 0.07
     #: grip force per finger (N), as in tests/cube_physics/rig.py and docs/benchmarks/cube_spike.md.
     grip_force: float = 20.0
     #: force per finger (N) of the first, gentle close when the other hand already holds the cube:
@@ -67,28 +72,27 @@ class PR2RubiksConfig:
     #: lever to the other gripper's pad axis, below what the other pads' friction resists (they hold
     #: the cube's weight at 34 mm without turning); then the force rises to ``grip_force``. 0: one stage.
     soft_grip_force: float = 3.0
-    #: duration of one quarter turn of the wrist (s).
-    quarter_turn_s: float = 1.0
-    #: joint-speed fraction for arm motions.
-    velocity_scale: float = 0.4
-    #: waypoints (per quarter turn) when the giver turns the cube in a hand-over.
-    handover_waypoints: int = 4
     #: largest joint change (rad) allowed between two hand-over waypoints when choosing the giver's grip.
     #: A quarter of a quarter turn moves the joints a few tenths of a rad on a smooth branch (the rolls
     #: are continuous and IK stays on the branch nearest the seed); a bigger change is the arm switching
     #: branch with the cube in hand (measured: a 3.9 s, 0.27 rad-tracking-error swing that turned the
     #: held cube 15 degrees when 2.5 rad was allowed).
     max_waypoint_jump: float = 0.8
+    #: where the fingers need not cross the other hand's: "parallel" prefers closing along the other
+    #: hand's pad axis (no torque about it), "crossing" prefers crossing them.
+    finger_preference: str = "parallel"
+    #: extra IK seeds (random self-motions of the 7-DOF arm) a giver's grip is also solved from: a
+    #: hand-over turn may be smooth only from another elbow/shoulder posture. The seeds come from a
+    #: generator seeded with the number of events recorded so far (deterministic per trial).
+    giver_seeds: int = 6
+    #: pre-touch (sensor-aided): std of the prior handed to the filter at each re-localisation, position
+    #: (m) and yaw (deg): of the order of the head camera's error (4 mm, 3 deg) that dead reckoning carries.
+    pretouch_prior_pos_std: float = 0.006
+    pretouch_prior_yaw_std_deg: float = 3.0
+    #: pre-touch (sensor-aided): the 3 x 3 emitter grid across the tool frame (m, tool y and z), all
+    #: looking along tool x: 12 mm apart, well inside the 57 mm face the hand approaches.
+    pretouch_grid: tuple[float, ...] = (-0.012, 0.0, 0.012)
     #: a motion that ends farther than this from its target counts as unreachable (m).
     reach_tolerance: float = 0.01
-    #: the cube counts as dropped if it ends farther than this from where it is believed (m).
-    drop_distance: float = 0.05
     #: pick approaches the planner may use (only "side" is implemented physically).
     pick_approaches: tuple[str, ...] = ("side",)
-    #: stop after this many plan actions (None: the whole plan); the outcome is then the state so far.
-    #: For tests and debugging (e.g. 1 = the pick only).
-    max_actions: int | None = None
-    errors: ErrorConfig = ErrorConfig()
-
-    def zero_error(self) -> PR2RubiksConfig:
-        return replace(self, errors=self.errors.zero())

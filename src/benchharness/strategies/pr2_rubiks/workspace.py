@@ -17,7 +17,8 @@ left arm (the right mirrors it, the robot being symmetric about y = 0):
 * ``turn_z``/``turn_x``: each hand-over turn the left giver can give
   (:func:`regrasp.model.handover_turns`) from its two-slab grip, in
   ``handover_waypoints`` steps and then ``handover_retreat`` back along the
-  approach, as :meth:`DeadReckoningStrategy._turn_travel` checks it: a chain
+  approach, as :meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`
+  checks it: a chain
   whose solutions follow each other (no joint step over ``max_waypoint_jump``);
 
 each as the *margin*: the smallest distance (rad) of any limited joint from
@@ -38,9 +39,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
+from ..bimanual.frames import grip_candidates, rotate_about_point
 from .config import PR2RubiksConfig
-from .frames import grip_candidates, rotate_about_point
-from .strategy import DeadReckoningStrategy
 
 __all__ = ["margins"]
 
@@ -116,11 +116,7 @@ def margins(
                 poses = [rotate_about_point(p, c, ax, angle * min(i, n) / n) for p in start]
                 if i > n:
                     poses = [
-                        Pose(
-                            p.p
-                            - p.rotation.apply([DeadReckoningStrategy.handover_retreat, 0.0, 0.0]),
-                            p.q,
-                        )
+                        Pose(p.p - p.rotation.apply([cfg.handover_retreat, 0.0, 0.0]), p.q)
                         for p in poses
                     ]
                 res = solve(poses, q)

@@ -1,9 +1,12 @@
 """Pure frame computations: gripper targets from an *estimated* cube pose (no physics).
 
-Conventions (docs/robots.md, docs/planner.md): the PR2 tool frame has
-x = approach (pointing from the palm into the object), y = the direction the
-fingers open and close; the wrist-roll joint turns about tool x through the
-tool-frame origin. The cube body frame is ``cube_physics``' (U = +z, R = +x,
+Robot-independent grip geometry of the bimanual Rubik's machine
+(:mod:`.machine`). Conventions (docs/robots.md, docs/planner.md): a *grip
+frame* has x = approach (pointing from the palm into the object), y = the
+direction the fingers open and close, as the PR2's tool frame does; the
+PR2's wrist-roll joint turns about tool x through the tool-frame origin. A
+robot whose tool frame is laid out otherwise turns these frames into its own
+(HERB: ``herb_rubiks.frames.HERB_FROM_PR2``). The cube body frame is ``cube_physics``' (U = +z, R = +x,
 F = -y). A grip "from direction d" puts the tool frame on the cube's face
 whose estimated outward normal is nearest the world direction ``d``, at
 ``offset`` from the cube centre along that normal, approaching along -normal,
@@ -21,6 +24,7 @@ from ...geometry import Pose
 
 __all__ = [
     "DIRECTIONS",
+    "along",
     "body_axis_along",
     "grip_candidates",
     "grip_pose",
@@ -39,6 +43,17 @@ DIRECTIONS: dict[str, np.ndarray] = {
     "y": np.array([0.0, 1.0, 0.0]),
     "z": np.array([0.0, 0.0, 1.0]),
 }
+
+
+def along(axis: int, value: float) -> np.ndarray:
+    """The tool-frame vector ``value`` along tool axis ``axis`` (0 = x, 1 = y, 2 = z), zeros elsewhere.
+
+    Built by assignment, not as ``value * unit``, so that a move of ``d`` along
+    tool x is exactly ``[d, 0, 0]`` (the same floats the PR2 baselines always used).
+    """
+    out = np.zeros(3)
+    out[axis] = value
+    return out
 
 
 def _vec(d: str | np.ndarray) -> np.ndarray:

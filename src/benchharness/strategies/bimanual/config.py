@@ -1,0 +1,87 @@
+"""Settings of the bimanual Rubik's state machine that every robot has: scene, motion, hand-over, error sources.
+
+Each robot's config (``PR2RubiksConfig``, ``HerbPushGraspConfig``) is a
+subclass that gives the scene its values and adds the fields of its own
+grasp primitive. Fields without a default here are the ones no robot can
+share (where the table is, how far its arm may jump between waypoints): a
+robot's config must give them. ``zero_error()`` gives the same configuration
+with every injected error set to 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import TypeVar
+
+from ..error_sources import ErrorConfig
+
+__all__ = ["BimanualConfig", "ErrorConfig"]
+
+_C = TypeVar("_C", bound="BimanualConfig")
+
+
+@dataclass(frozen=True, kw_only=True)
+class BimanualConfig:
+    """What the state machine (:class:`.machine.BimanualRubiksMachine`) reads (metres, seconds, radians)."""
+
+    #: height of the table top (m) the cube starts on.
+    table_height: float
+    #: half extents (x, y) of the table top (m).
+    table_half_size: tuple[float, float]
+    #: cube centre on the table in the robot base frame (x forward, y left).
+    cube_xy: tuple[float, float]
+    #: where the cube is held for twisting (cube centre, robot base frame): the pick lifts and carries it there.
+    twist_position: tuple[float, float, float]
+    #: largest joint change (rad) allowed between two hand-over waypoints, and between a free hand's joints
+    #: and its retreat's IK solution: a bigger change is the arm switching branch (elbow or shoulder) with
+    #: the cube in hand or round it.
+    max_waypoint_jump: float
+    #: how far a hand backs off along its approach after letting go (m), unless the action says otherwise.
+    retreat_distance: float
+    #: stand-off (m) along the approach that a free hand swings round to before it moves in to grip: the
+    #: open fingers must clear the cube while the wrist turns (the PR2's open to 90 mm, and a swing of the
+    #: wrist at its 7 cm pre-grasp can sweep the 57 mm cube).
+    far_distance: float = 0.15
+    #: a free hand swings round the cube on an arc about its believed centre in Cartesian waypoints at most
+    #: this many degrees apart (:meth:`.machine.BimanualRubiksMachine._swing`): one joint-space move from
+    #: one side of the cube to another sweeps the hand along whatever path the joints take.
+    swing_step_deg: float = 45.0
+    #: a hand whose stand-off is less than this many degrees round the cube from where it is moves straight
+    #: there (so does one within one ``swing_step_deg``). 0: only the step decides.
+    swing_min_deg: float = 0.0
+    #: only a hand whose tool frame starts nearer the believed cube centre than this (m) swings round it;
+    #: one farther away (an arm out at its side) moves straight to its stand-off. inf: every hand swings.
+    swing_radius: float = float("inf")
+    #: how far the taker backs off along its approach (m) before the giver turns the cube in a hand-over:
+    #: the turn carries the cube past where the taker's open fingers were.
+    taker_retreat: float = 0.15
+    #: how far the giver backs off along its approach after a hand-over (m). The hand-over turn's IK chain
+    #: is checked to end with this retreat (:meth:`.machine.BimanualRubiksMachine._turn_travel`): a turn
+    #: that ends at a joint limit leaves no straight way out, and the retreat swings through the cube.
+    handover_retreat: float = 0.12
+    #: waypoints per quarter turn when the giver turns the cube in a hand-over.
+    handover_waypoints: int = 4
+    #: the hand that is about to hold the cube alone (the picker, a hand-over's taker) grips two slabs deep
+    #: whichever hand rotates next, and the other hand then joins (if the lone hand rotates next, the other
+    #: grips two slabs deep, crossing, and the lone hand slides out to one slab). Why: a one-slab grip holding
+    #: the cube alone lets it pivot about the pad axis (PR2, measured on PyBullet: 32 degrees as the giver let
+    #: go). False: the lone hand grips at the depth the plan gives it next (one slab if it rotates next).
+    lone_holder_two_slabs: bool = True
+    #: duration of one quarter turn of the wrist (s).
+    quarter_turn_s: float = 1.0
+    #: joint-speed fraction for arm motions.
+    velocity_scale: float = 0.4
+    #: an arm motion that ends farther than this from its target is logged as a warning event (m); None: no
+    #: check. The PR2 baselines leave it off: their giver's extra IK seeds are drawn from a generator seeded
+    #: with the number of events recorded so far, so a new event would change their results.
+    reach_warning: float | None = None
+    #: the cube counts as dropped if it ends below the table top + 1 cm and this far from the belief (m).
+    drop_distance: float = 0.05
+    #: stop after this many plan actions (None: the whole plan); the outcome is then the state so far.
+    #: For tests and debugging (e.g. 1 = the pick only).
+    max_actions: int | None = None
+    errors: ErrorConfig = ErrorConfig()
+
+    def zero_error(self: _C) -> _C:
+        """The same configuration with every injected error 0."""
+        return replace(self, errors=self.errors.zero())

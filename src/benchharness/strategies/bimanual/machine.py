@@ -1,0 +1,846 @@
+"""The one bimanual Rubik's state machine: plan, pick the cube up, twist, regrasp, hand over, release.
+
+Control never reads the true cube pose. The cube's pose is *believed*: the
+head camera's one-shot estimate on the table, then carried by whichever hand
+holds it alone, through that hand's *commanded* tool poses (``Hand.cmd``),
+and corrected by whatever a robot's grasp primitive measures (a pre-touch
+reading, a push-grasp's contact). The injected errors
+(:class:`..error_sources.ErrorConfig`) sit between the command and the arm:
+the arm is sent ``calibration * noise * commanded``, which the strategy never
+learns. The true pose is read only for the recorder's true-vs-believed
+diagnostics and the judge's dropped-cube check.
+
+What is the machine's (every robot's): the scene, the injected errors, the
+plan and its dispatch, the camera estimate, the drop check, the hand-over
+(the giver's turn, the take, the re-grip), the twist and its bookkeeping,
+the swing round the cube to a stand-off, the check that a hand-over turn can
+be carried smoothly (with the giver's retreat), and the retreat after letting
+go. What is a robot's: a :class:`GraspModule` (its candidate grips and their
+scoring, how it moves in and closes, how it opens), and its config (a
+subclass of :class:`.config.BimanualConfig`). A new two-armed robot is a new
+grasp module, not a new state machine (docs/strategies.md, "Adding a robot").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ...backends.interface import Box, CameraSpec
+from ...geometry import Pose
+from ...runner.contract import RubiksItem, TrialContext, TrialOutcome
+from ..regrasp import (
+    HandModel,
+    Handover,
+    Pick,
+    Regrasp,
+    RegraspPlan,
+    Release,
+    Twist,
+    execute,
+    plan_sequence,
+    twist_move,
+)
+from .config import BimanualConfig
+from .frames import along, rotate_about_point
+
+__all__ = [
+    "BODY_AXIS_OF_FACE",
+    "CUBE_HALF",
+    "SIDE_DIR",
+    "BimanualRubiksMachine",
+    "GraspModule",
+    "GripRequest",
+    "Hand",
+    "StrategyFailure",
+]
+
+CUBE_HALF = 0.0285
+#: the world direction each hand grips from (the planner's grips are all side grips)
+SIDE_DIR = {"left": "+y", "right": "-y"}
+BODY_AXIS_OF_FACE = {"U": "z", "D": "z", "R": "x", "L": "x", "F": "y", "B": "y"}
+
+
+class StrategyFailure(Exception):
+    """A failure the strategy detected itself: ``cause`` is a runner FailureCause value or None."""
+
+    def __init__(self, cause: str | None, message: str) -> None:
+        super().__init__(message)
+        self.cause = cause
+
+
+@dataclass
+class Hand:
+    """One arm + hand and what the strategy believes about it."""
+
+    side: str
+    arm: Any
+    gripper: Any
+    calibration: Pose  #: injected, never read by control: actual = calibration * commanded
+    cmd: Pose  #: the last commanded (believed) tool pose
+    holding: bool = False
+    cube_in_tcp: Pose | None = None  #: believed cube pose in the commanded tool frame
+    grip_dir: str | None = None  #: world direction the hand grips from ("+y", "-x", ...)
+    last_grip: Pose | None = (
+        None  #: the commanded tool pose of the last grip (retreats go back from it)
+    )
+    depth: int = 0  #: slabs the current grip covers (0: not holding)
+    state: Any = None  #: the grasp module's own per-hand state (:meth:`GraspModule.hand_state`)
+    log: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class GripRequest:
+    """What the machine asks of a grasp module's grip.
+
+    ``relation`` to the other hand's fingers if it holds the cube: "cross"
+    (the fingers must cross the other hand's: the grips overlap along the
+    work axis), "parallel" (they must pinch the same pair of faces), or None
+    (a preference only, the module's).
+    """
+
+    world_dir: str  #: the world direction the hand grips from
+    depth: int  #: 1 = the rotator's one slab, 2 = the holder's two
+    label: str  #: for events and messages
+    turn: tuple[str, float] | None = (
+        None  #: this hand gives the cube next: the hand-over turn (axis, rad)
+    )
+    twist_delta: float = 0.0  #: wrist-roll change of this hand's next twist (rad; 0: none planned)
+    on_table: bool = False  #: the cube is on the table: no finger may go under it
+    relation: str | None = None
+    take: bool = False  #: a hand-over's take (the other hand is the giver)
+
+
+class GraspModule(Protocol):
+    """A robot's grasp primitives: all the machine needs that differs between robots.
+
+    Tool-frame layout (every hand's tool frame is ``{side}_arm``'s): ``approach_axis`` and ``finger_axis`` are the tool
+    axes (0 = x, 1 = y, 2 = z) along which the hand approaches the face it
+    grips and across which its fingers close; the wrist's last joint rolls
+    about the approach axis.
+    """
+
+    approach_axis: int
+    finger_axis: int
+    #: the robot's hand per arm, by side: ``robot.gripper(gripper_name.format(side=side))``
+    gripper_name: str
+    #: the only robot (plugin name) the module's hands exist on; None: any robot with the arms and hands
+    robot_name: str | None
+
+    @property
+    def config(self) -> BimanualConfig:
+        """The robot's config: a :class:`.config.BimanualConfig` with the module's own fields added."""
+        ...
+
+    def hand_model(self) -> HandModel:
+        """The regrasp planner's model of this robot's hands."""
+        ...
+
+    def hand_state(self) -> Any:
+        """A fresh per-hand state for :attr:`Hand.state` (None if the module keeps none)."""
+        ...
+
+    def take_relation(self) -> str | None:
+        """The :attr:`GripRequest.relation` of a hand-over's take."""
+        ...
+
+    def choose(
+        self, m: BimanualRubiksMachine, hand: Hand, req: GripRequest
+    ) -> tuple[Pose, np.ndarray | None]:
+        """The grip (commanded tool pose) to take, among the robot's candidate grips by its own scoring,
+        and the IK solution the choice was made with (None: the arm moves there from where it is).
+
+        May move the fingers (a pre-shape) but not the arm; raises :class:`StrategyFailure` if no grip fits.
+        """
+        ...
+
+    def ready(self, m: BimanualRubiksMachine, hand: Hand, req: GripRequest) -> None:
+        """Ready the hand to approach (open it), after :meth:`choose`, before the swing to the stand-off."""
+        ...
+
+    def close_in(
+        self,
+        m: BimanualRubiksMachine,
+        hand: Hand,
+        grip: Pose,
+        q_plan: np.ndarray | None,
+        req: GripRequest,
+    ) -> None:
+        """From the stand-off: move in to ``grip`` and close; raise :class:`StrategyFailure` on a miss.
+
+        The machine then records the hand as holding at its commanded pose.
+        """
+        ...
+
+    def open(self, m: BimanualRubiksMachine, hand: Hand) -> None:
+        """Open the hand (let go of the cube), the arm where it is."""
+        ...
+
+    def regrip_before_twist(self, m: BimanualRubiksMachine, rot: Hand, delta: float) -> bool:
+        """Whether the rotator, holding with the holder, must let go and grip again before rolling ``delta``."""
+        ...
+
+    def twist_diagnostics(self, m: BimanualRubiksMachine, body_axis: str) -> dict | None:
+        """Diagnostic recorded before a twist as a ``twist_contacts`` event (None: no event)."""
+        ...
+
+
+class BimanualRubiksMachine:
+    """Rubik's strategy for a two-armed robot; its grasp primitives are ``grasp``'s (see the module docstring).
+
+    A robot's strategy is this class with its grasp module and a name: a
+    subclass may set ``name`` and build its grasp module in ``__init__``, and
+    nothing else (tests/strategies/test_bimanual.py checks).
+    """
+
+    benchmarks: ClassVar[tuple[str, ...]] = ("rubiks",)
+    name: ClassVar[str] = "bimanual"
+
+    def __init__(self, grasp: GraspModule) -> None:
+        self.grasp = grasp
+
+    @property
+    def config(self) -> BimanualConfig:
+        return self.grasp.config
+
+    # ------------------------------------------------------------------ trial
+    def video_camera(self, view: str, size: tuple[int, int]) -> CameraSpec:
+        """The trial video's camera (``run --video-view``): ``close`` frames both hands at the
+        twisting pose above the table and the cube on it, ``wide`` the robot (runner/video.py)."""
+        from ...runner.video import rubiks_camera
+
+        cfg = self.config
+        x, y = cfg.cube_xy
+        return rubiks_camera((x, y, cfg.table_height + 0.08), view, size)
+
+    def run_trial(self, ctx: TrialContext) -> TrialOutcome:
+        from ...cube_physics import PhysicalCube
+
+        want = self.grasp.robot_name
+        got = getattr(ctx.robot, "name", None)
+        if want is not None and got != want:
+            raise ValueError(
+                f"strategy {self.name!r} drives robot {want!r} (grasp module "
+                f"{type(self.grasp).__name__}); got robot {got!r}"
+            )
+        cfg = self.config
+        b = ctx.backend
+        self.ctx = ctx
+        self.b = b
+        b.add_ground()
+        h = cfg.table_height
+        tx, ty = cfg.table_half_size
+        b.add_body(
+            [Box((tx, ty, h / 2), rgba=(0.55, 0.40, 0.26, 1.0))],  # wood, in a video
+            Pose(np.array([cfg.cube_xy[0], cfg.cube_xy[1], h / 2])),
+            1.0,
+            fixed=True,
+            name="table",
+        )
+        # protocol: top face up, F facing the robot (body -y -> world -x: yaw -90 deg)
+        true0 = Pose.from_rotation(
+            [cfg.cube_xy[0], cfg.cube_xy[1], h + CUBE_HALF + 5e-4],
+            Rotation.from_euler("z", -90, degrees=True),
+        )
+        self.cube = PhysicalCube(b, true0)
+        robot = ctx.robot
+        robot.spawn(b)
+        self.robot = robot
+        return self._run(ctx)  # the cube keeps its own detents current (a step callback)
+
+    def _run(self, ctx: TrialContext) -> TrialOutcome:
+        cfg, rec, b = self.config, ctx.recorder, self.b
+        err = cfg.errors
+        rng = ctx.rng
+        self.hands: dict[str, Hand] = {}
+        for side in ("left", "right"):
+            dp = rng.normal(0.0, err.calib_pos_std, 3) if err.calib_pos_std else np.zeros(3)
+            dr = (
+                rng.normal(0.0, math.radians(err.calib_rot_std_deg), 3)
+                if err.calib_rot_std_deg
+                else np.zeros(3)
+            )
+            arm = self.robot.arm(f"{side}_arm")
+            self.hands[side] = Hand(
+                side,
+                arm,
+                self.robot.gripper(self.grasp.gripper_name.format(side=side)),
+                Pose.from_rotation(dp, Rotation.from_rotvec(dr)),
+                arm.tcp_pose(),
+                state=self.grasp.hand_state(),
+            )
+        self.robot.settle(0.2)
+        rec.watch_contact(self.cube.body, self.robot.body)
+        self.est = self._camera_estimate(ctx)
+        rec.pose_estimate(0, self.cube.pose(), self.est, label="camera")
+
+        if not isinstance(ctx.item, RubiksItem):
+            raise ValueError(f"strategy {self.name!r} runs Rubik's tasks, not {ctx.item!r}")
+        plan = plan_sequence(ctx.item.sequence, self.grasp.hand_model())
+        trace = execute(plan).orientations
+        rec.event(
+            "plan",
+            actions=len(plan.actions),
+            twists=plan.twists,
+            regrasps=plan.regrasps,
+            handovers=plan.handovers,
+            text=plan.describe(),
+        )
+        self.plan: RegraspPlan = plan
+        self.trace = trace
+        self.t_release: float | None = None
+        #: the plan's move the latest twist made (0 before the first): the x of pose-estimate records
+        self.move_index = 0
+        try:
+            for k, action in enumerate(plan.actions):
+                if cfg.max_actions is not None and k >= cfg.max_actions:
+                    rec.event("stopped", after_actions=k)
+                    self.t_release = b.time
+                    break
+                before = trace[k - 1] if k > 0 else plan.initial
+                rec.event("action", index=k, action=type(action).__name__, detail=repr(action))
+                if isinstance(action, Pick):
+                    self._pick(action, k)
+                elif isinstance(action, Twist):
+                    self.move_index = max(action.source, 0)
+                    self._twist(action, before, k)
+                elif isinstance(action, Regrasp):
+                    self._regrasp(action, k)
+                elif isinstance(action, Handover):
+                    self._handover(action, k)
+                elif isinstance(action, Release):
+                    self._release()
+                if not isinstance(action, Release):
+                    self._check_drop(k)
+                    # after the release the cube lies on the table and nothing believes where:
+                    # logging that estimate would plot as a 7 cm "error" at the last move
+                    rec.pose_estimate(
+                        self.move_index,
+                        self.cube.pose(),
+                        self.est,
+                        label=type(action).__name__.lower(),
+                    )
+        except StrategyFailure as e:
+            rec.event("failure", cause=e.cause, message=str(e))
+            t_end = b.time
+            if e.cause is None:
+                return TrialOutcome(
+                    final_state=self.cube.state_string,
+                    termination_s=t_end,
+                    message=str(e),
+                    extra=self._extra(),
+                )
+            return TrialOutcome(
+                failure=e.cause,
+                message=str(e),
+                termination_s=t_end,
+                final_state=None,
+                extra=self._extra(),
+            )
+        t_release = self.t_release if self.t_release is not None else b.time
+        return TrialOutcome(
+            final_state=self.cube.state_string, termination_s=t_release, extra=self._extra()
+        )
+
+    def _extra(self) -> dict:
+        return {
+            "twists": [o.summary() for o in self.cube.history],
+            "misaligned": self.cube.misaligned,
+            "errors": {s: h.calibration.as_array().tolist() for s, h in self.hands.items()},
+        }
+
+    # ------------------------------------------------------------- sensing
+    def _camera_estimate(self, ctx: TrialContext) -> Pose:
+        err = self.config.errors
+        true = self.cube.pose()
+        if not err.camera:
+            return true
+        slot = ctx.sensors.get("head-camera") if ctx.sensors else None
+        try:
+            from ...sensors import HeadCamera
+        except ImportError:  # sensors package absent: a documented Gaussian from ctx.rng
+            p = true.p + ctx.rng.normal(0.0, err.camera_pos_std, 3)
+            yaw = Rotation.from_euler(
+                "z", ctx.rng.normal(0.0, err.camera_yaw_std_deg), degrees=True
+            )
+            return Pose.from_rotation(p, yaw * true.rotation)
+        cam = slot.create() if slot is not None else HeadCamera()
+        rng = slot.rng if slot is not None else ctx.rng
+        return cam.estimate(true, rng, time=self.b.time).pose
+
+    def _check_drop(self, k: int) -> None:
+        """Judge's check (not control): the cube far from where it is believed and below the hands."""
+        true = self.cube.pose()
+        if (
+            true.p[2] < self.config.table_height + CUBE_HALF + 0.01
+            and np.linalg.norm(true.p - self.est.p) > self.config.drop_distance
+        ):
+            raise StrategyFailure(
+                "dropped", f"action {k + 1}: the cube fell (at {np.round(true.p, 3).tolist()})"
+            )
+
+    def _judge(self, label: str, hand: Hand | None = None) -> None:
+        """Diagnostic event (not control): how far the true cube is from the belief right now.
+
+        Recorded after every grasp and at the steps of a hand-over, so that a
+        failure's record says at which step the cube moved in a grip.
+        """
+        true = self.cube.pose()
+        rv = (true.rotation * self.est.rotation.inv()).as_rotvec()
+        data: dict[str, Any] = {
+            "label": label,
+            "err_mm": round(float(1000 * np.linalg.norm(true.p - self.est.p)), 2),
+            "rot_deg": np.round(np.degrees(rv), 1).tolist(),
+        }
+        if hand is not None:
+            data["hand"] = hand.side
+            fingers = hand.cmd.rotation.apply(along(self.grasp.finger_axis, 1.0))
+            data["fingers"] = np.round(fingers, 2).tolist()
+        self.ctx.recorder.event("check", **data)
+
+    # ------------------------------------------------------------- motion
+    def noise(self) -> np.ndarray:
+        """One draw of the actuator tracking error (m, world), from the trial's rng."""
+        err = self.config.errors
+        return self.ctx.rng.normal(0.0, err.tracking_std, 3) if err.tracking_std else np.zeros(3)
+
+    @staticmethod
+    def actual(hand: Hand, target: Pose, noise: np.ndarray) -> Pose:
+        """What the arm is sent for the commanded ``target``: the injected calibration and ``noise`` added."""
+        cal = hand.calibration
+        return Pose.from_rotation(target.p + cal.p + noise, cal.rotation * target.rotation)
+
+    def back_off(self, pose: Pose, distance: float) -> Pose:
+        """``pose`` moved ``distance`` back along its own approach axis."""
+        return Pose(pose.p - pose.rotation.apply(along(self.grasp.approach_axis, distance)), pose.q)
+
+    def send(
+        self,
+        hand: Hand,
+        target: Pose,
+        *,
+        label: str,
+        duration: float | None = None,
+        settle: float = 0.2,
+        seed_q: np.ndarray | None = None,
+    ) -> None:
+        """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors."""
+        res = hand.arm.move_to_pose(
+            self.actual(hand, target, self.noise()),
+            duration=duration,
+            velocity_scale=self.config.velocity_scale,
+            settle=settle,
+            seed_q=seed_q,
+        )
+        hand.cmd = target
+        if hand.holding:
+            hand.last_grip = target
+        warn = self.config.reach_warning
+        if warn is not None and res.ik_success and res.pos_error > warn:
+            self.ctx.recorder.event(
+                "warning",
+                message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
+                f"its {label} target (joint error {res.final_joint_error:.3f} rad)",
+            )
+        if not res.ik_success:
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: no IK solution for {label} "
+                f"(target {np.round(target.p, 3).tolist()})",
+            )
+        if hand.holding and not self.other(hand).holding and hand.cube_in_tcp is not None:
+            self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
+
+    def other(self, hand: Hand) -> Hand:
+        return self.hands["right" if hand.side == "left" else "left"]
+
+    def reanchor(self) -> None:
+        """After the belief was corrected by a measurement: what each holding hand believes it carries."""
+        for h in self.hands.values():
+            if h.holding:
+                h.cube_in_tcp = h.cmd.inv() * self.est
+
+    def _smooth(self, hand: Hand, target: Pose) -> bool:
+        """Whether the arm reaches ``target`` from its joints without any joint moving > max_waypoint_jump."""
+        base = hand.arm.base_pose()
+        q = hand.arm.positions()
+        res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
+        return (
+            bool(res.success[0])
+            and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
+        )
+
+    def turn_travel(
+        self,
+        hand: Hand,
+        base: Pose,
+        grips: list[Pose],
+        q: np.ndarray,
+        axis: str,
+        angle: float,
+        with_retreat: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Joint travel of carrying the cube from each of ``grips`` through the hand-over turn (inf: not
+        smooth), and the largest joint step on the way (inf: a waypoint out of reach).
+
+        ``q`` holds each grip's IK solution (one row a grip); all grips are solved in one batched IK
+        call per waypoint, each seeded with its own previous solution. The chain ends with the giver's
+        retreat from the turned grip (``handover_retreat`` back along its approach): a turn that ends
+        at a joint limit leaves no straight way out, and the arm's retreat then swings through the cube.
+        ``with_retreat=False``: the turn's waypoints only (a robot's fallback when no grip passes).
+        """
+        cfg = self.config
+        n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
+        q = np.array(q, dtype=float)
+        total = np.zeros(len(grips))
+        worst = np.zeros(len(grips))
+        for i in range(1, n + 2 if with_retreat else n + 1):
+            live = np.flatnonzero(np.isfinite(worst))
+            if live.size == 0:
+                break
+            poses = [
+                rotate_about_point(grips[k], self.est.p, axis, angle * min(i, n) / n) for k in live
+            ]
+            if i > n:  # the retreat
+                poses = [self.back_off(p, cfg.handover_retreat) for p in poses]
+            targets = [(base.inv() * p).as_matrix() for p in poses]
+            res = hand.arm.ik(np.stack(targets), seed_q=q[live])
+            jump = np.max(np.abs(res.q - q[live]), axis=1)
+            reached = np.asarray(res.success, dtype=bool)
+            bad = ~reached | (jump > cfg.max_waypoint_jump)
+            total[live] = np.where(bad, np.inf, total[live] + jump)
+            worst[live] = np.where(reached, np.maximum(worst[live], jump), np.inf)
+            q[live] = res.q
+        return total, worst
+
+    def _swing(self, hand: Hand, far: Pose, label: str, seed_q: np.ndarray | None = None) -> None:
+        """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed centre.
+
+        Why: one joint-space move from where the hand let go (often above or
+        below the cube after a hand-over turn) to a stand-off on another side
+        sweeps the tool frame along whatever path the joints take, and was
+        measured knocking the held cube 12 degrees (PR2, SAPIEN, Rubiks-1-20)
+        and sweeping a re-gripping hand through the taker's thumb (HERB,
+        SAPIEN). Here the tool frame moves in Cartesian waypoints (at most
+        ``swing_step_deg`` apart) on an arc round the cube, its distance from
+        the centre and its orientation interpolated between the two ends, so
+        it never comes nearer the cube than where it started or ends. A
+        waypoint the arm cannot reach is left out. A hand farther than
+        ``swing_radius`` from the cube, or whose stand-off is less than
+        ``swing_min_deg`` round it, moves straight to the stand-off.
+        """
+        from scipy.spatial.transform import Slerp
+
+        cfg = self.config
+        c = self.est.p
+        d0, d1 = hand.cmd.p - c, far.p - c
+        r0, r1 = float(np.linalg.norm(d0)), float(np.linalg.norm(d1))
+        u0, u1 = d0 / max(r0, 1e-9), d1 / max(r1, 1e-9)
+        angle = math.acos(float(np.clip(np.dot(u0, u1), -1.0, 1.0)))
+        n = max(1, math.ceil(angle / math.radians(cfg.swing_step_deg)))
+        if (
+            n == 1
+            or r0 < 0.05
+            or r1 < 0.05
+            or r0 > cfg.swing_radius
+            or math.degrees(angle) < cfg.swing_min_deg
+        ):
+            self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+            return
+        axis = np.cross(u0, u1)
+        if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
+            axis = np.cross(u0, [0.0, 0.0, 1.0])
+            if np.linalg.norm(axis) < 1e-6:
+                axis = np.array([1.0, 0.0, 0.0])
+        axis = axis / np.linalg.norm(axis)
+        slerp = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([hand.cmd.q, far.q])))
+        base = hand.arm.base_pose()
+        for i in range(1, n):
+            f = i / n
+            u = Rotation.from_rotvec(axis * angle * f).apply(u0)
+            way = Pose.from_rotation(c + ((1 - f) * r0 + f * r1) * u, slerp([f])[0])
+            if hand.arm.ik(
+                (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
+            ).success[0]:
+                self.send(hand, way, label=f"{label} arc", settle=0.02)
+        self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+
+    def release_hand(self, hand: Hand, retreat: float | None = None) -> None:
+        """Open (if holding) and stand off ``retreat`` (default ``retreat_distance``) along the approach
+        from the last grip.
+
+        The open hand is still round the cube, so the retreat must be a
+        straight move: if the stand-off's IK solution is more than
+        ``max_waypoint_jump`` from the arm's joints (a joint limit on the way
+        out, another branch beyond), it backs off in 2 cm steps only as far
+        as the arm follows smoothly and logs a warning.
+        """
+        if hand.holding:
+            self.grasp.open(self, hand)
+        hand.holding, hand.cube_in_tcp, hand.grip_dir, hand.depth = False, None, None, 0
+        d = self.config.retreat_distance if retreat is None else retreat
+        ref = hand.last_grip or hand.cmd
+        back = self.back_off(ref, d)
+        if not (
+            np.linalg.norm(back.p - hand.cmd.p) > 2e-3
+            or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)
+        ):
+            return
+        if self._smooth(hand, back):
+            self.send(hand, back, label="retreat", settle=0.05)
+            return
+        step = 0.02
+        approach = ref.rotation.apply(along(self.grasp.approach_axis, 1.0))
+        dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
+        while dist + step <= d + 1e-9:
+            nxt = self.back_off(ref, dist + step)
+            if not self._smooth(hand, nxt):
+                break
+            self.send(hand, nxt, label="retreat step", settle=0.02)
+            dist += step
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
+            f"(the straight way out leaves the arm's branch)",
+        )
+
+    def grip(
+        self,
+        hand: Hand,
+        world_dir: str,
+        depth: int,
+        label: str,
+        k: int | None = None,
+        *,
+        gives: bool = True,
+        on_table: bool = False,
+        relation: str | None = None,
+        take: bool = False,
+        twist_delta: float | None = None,
+    ) -> None:
+        """``hand`` grips the cube from ``world_dir``, ``depth`` slabs deep: choose, swing to the stand-off,
+        move in and close (the last by the grasp module), then the bookkeeping.
+
+        ``k``: the plan action this grip serves; with ``gives`` a two-slab grip is chosen so that the
+        hand can carry its next hand-over turn, if it gives the cube next. ``twist_delta``: the wrist
+        roll of the hand's next twist (default: from the plan after action ``k``).
+        """
+        turn = self._next_turn(k, hand.side) if (gives and k is not None and depth == 2) else None
+        if twist_delta is None:
+            twist_delta = self._next_twist_delta(k, hand.side) if depth == 1 else 0.0
+        req = GripRequest(world_dir, depth, label, turn, twist_delta, on_table, relation, take)
+        grasp = self.grasp
+        pose, q_plan = grasp.choose(self, hand, req)
+        grasp.ready(self, hand, req)
+        far = self.back_off(pose, self.config.far_distance)
+        if (
+            np.linalg.norm(far.p - hand.cmd.p) > 0.01
+            or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999
+        ):
+            # swing round to the far stand-off first, so that the swing clears the cube
+            self._swing(hand, far, label=f"{label} stand-off", seed_q=q_plan)
+        grasp.close_in(self, hand, pose, q_plan, req)
+        hand.holding = True
+        hand.last_grip = hand.cmd
+        hand.cube_in_tcp = hand.cmd.inv() * self.est
+        hand.grip_dir, hand.depth = world_dir, depth
+        self._judge(label, hand)
+
+    def _next_turn(self, k: int | None, side: str) -> tuple[str, float] | None:
+        """If ``side``'s next regrasp after action ``k`` is giving the cube in a hand-over: (axis, angle)."""
+        if k is None:
+            return None
+        for a in self.plan.actions[k + 1 :]:
+            if isinstance(a, Handover):
+                return (a.axis, a.quarter_turns * math.pi / 2) if a.giver == side else None
+            if isinstance(a, Regrasp):
+                return None
+        return None
+
+    def _next_twist_delta(self, k: int | None, side: str) -> float:
+        """The wrist roll of the next twist after action ``k`` if ``side`` rotates it (else 0)."""
+        if k is None:
+            return 0.0
+        for a in self.plan.actions[k + 1 :]:
+            if isinstance(a, Twist):
+                return self._roll_delta(a) if a.gripper == side else 0.0
+        return 0.0
+
+    @staticmethod
+    def _roll_delta(t: Twist) -> float:
+        """Wrist-roll change for a twist: ``quarter_turns`` right-handed about +y; the left approach is -y."""
+        phi = t.quarter_turns * math.pi / 2
+        return -phi if t.gripper == "left" else phi
+
+    def _lone_depth(self, hand: Hand, rotator: str) -> int:
+        """How deep a hand that will hold the cube alone grips (see ``lone_holder_two_slabs``)."""
+        if self.config.lone_holder_two_slabs:
+            return 2
+        return 1 if rotator == hand.side else 2
+
+    # ------------------------------------------------------------- actions
+    def _pick(self, a: Pick, k: int) -> None:
+        if a.approach != "side":
+            raise StrategyFailure(
+                None, f"pick approach {a.approach!r} is not implemented (side only)"
+            )
+        cfg = self.config
+        picker = self.hands[a.gripper]
+        other = self.other(picker)
+        depth = self._lone_depth(picker, a.rotator)
+        self.grip(picker, SIDE_DIR[picker.side], depth, "pick", k, gives=False, on_table=True)
+        lift = np.asarray(cfg.twist_position) - self.est.p
+        up = Pose(picker.cmd.p + [0, 0, lift[2] + 0.03], picker.cmd.q)
+        self.send(picker, up, label="lift")
+        there = Pose(picker.cmd.p + [lift[0], lift[1], -0.03], picker.cmd.q)
+        self.send(picker, there, label="carry")
+        self._join(picker, other, a.rotator, "second grasp", "pick shift out", k)
+
+    def _join(
+        self, alone: Hand, free: Hand, rotator: str, label: str, shift_label: str, k: int
+    ) -> None:
+        """The free hand joins the hand holding alone so that the next rotator holds one slab.
+
+        If the lone holder holds two slabs and rotates next, the free hand grips two slabs deep,
+        fingers crossing (it becomes the holder), and the lone hand lets go and slides out to one
+        slab; otherwise the free hand grips the depth the lone hand leaves.
+        """
+        if rotator == alone.side and alone.depth == 2:
+            self.grip(free, SIDE_DIR[free.side], 2, label, k, relation="cross")
+            self.release_hand(alone)
+            self.grip(alone, SIDE_DIR[alone.side], 1, shift_label, k)
+        else:
+            self.grip(free, SIDE_DIR[free.side], 3 - alone.depth, label, k)
+
+    def _twist(self, t: Twist, orientation, k: int) -> None:
+        cube, rec = self.cube, self.ctx.recorder
+        rot, hold = self.hands[t.gripper], self.other(self.hands[t.gripper])
+        delta = self._roll_delta(t)
+        if (
+            rot.holding
+            and hold.holding
+            and hold.depth == 2
+            and self.grasp.regrip_before_twist(self, rot, delta)
+        ):
+            self.release_hand(rot)
+        if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
+            # after a twist the rotator stands off: a twist right after a twist re-takes its slab
+            if hold.holding and hold.depth == 2 and not rot.holding:
+                self.grip(rot, SIDE_DIR[rot.side], 1, "re-grip", twist_delta=delta)
+        if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
+            raise StrategyFailure(None, f"twist {k + 1}: hands not in twisting grips")
+        move = twist_move(orientation, t.axis, t.layer, t.quarter_turns)
+        # the body axis along the work axis, from the *believed* pose
+        local = self.est.rotation.inv().apply([0.0, 1.0, 0.0])
+        body_axis = "xyz"[int(np.argmax(np.abs(local)))]
+        intended = str(move) if BODY_AXIS_OF_FACE[move.kind] == body_axis else None
+        reason = cube.block_reason(body_axis)
+        if reason is not None:
+            rec.blocked_rotation(t.source, str(move), reason)
+            raise StrategyFailure("jammed", f"twist {k + 1} ({move}): {reason}")
+        # diagnostic (engine contacts, not control); read before the swap: the old body's contacts go with it
+        diag = self.grasp.twist_diagnostics(self, body_axis)
+        if diag is not None:
+            rec.event("twist_contacts", **diag)
+        cube.begin_twist(body_axis, intended=intended)
+        # from the measured joints, which track a goal on a soft limit to within ~1e-4 rad of either
+        # side: the goal is kept on the limit (measured: one goal 1e-4 rad past the upper-arm roll's)
+        lo, hi = rot.arm.lower, rot.arm.upper
+        q = np.clip(rot.arm.positions(), lo, hi)
+        want = q[-1] + delta
+        q[-1] = np.clip(want, lo[-1], hi[-1])  # a continuous wrist roll (inf limits) runs in full
+        if abs(q[-1] - want) > 1e-6:
+            rec.event(
+                "warning",
+                message=f"twist {k + 1}: wrist roll limited to {math.degrees(q[-1]):.0f}° "
+                f"({math.degrees(want - q[-1]):.0f}° short)",
+            )
+        rot.arm.move_to_joints(
+            q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2
+        )
+        rolled = Rotation.from_rotvec(along(self.grasp.approach_axis, delta))
+        rot.cmd = rot.last_grip = Pose.from_rotation(rot.cmd.p, rot.cmd.rotation * rolled)
+        self.grasp.open(self, rot)
+        out = cube.end_twist()
+        rec.move(
+            t.source,
+            str(move),
+            outcome=out.summary(),
+            moves=out.moves,
+            layer_angles_deg=list(out.layer_angles_deg),
+            jammed=out.jammed,
+            misaligned=out.misaligned,
+            as_intended=out.as_intended,
+            body_axis=body_axis,
+        )
+        if out.unintended_rotation:
+            rec.unintended_rotation(
+                t.source, str(move), out.moves or "misaligned", dragged_deg=out.dragged_deg
+            )
+        if out.jammed:
+            rec.blocked_rotation(t.source, str(move), "the turning layer did not turn (jammed)")
+            raise StrategyFailure("jammed", f"twist {k + 1} ({move}) jammed: {out.summary()}")
+        # the rotator backs off (opening again: it still counts as holding); the next regrasp or
+        # hand-over takes it from there
+        self.release_hand(rot)
+
+    def _regrasp(self, a: Regrasp, k: int) -> None:
+        if a.kind == "unwind":  # the rotator lets go, rolls back (a fresh choice) and re-grips
+            rot = self.hands[a.gripper]
+            self.release_hand(rot)
+            self.grip(rot, SIDE_DIR[rot.side], 1, "unwind", k)
+            return
+        if a.kind != "shift":
+            raise StrategyFailure(None, f"regrasp {a.kind!r} is not implemented")
+        new_rot = self.hands[a.gripper]
+        new_hold = self.other(new_rot)
+        # the old rotator slides in to two slabs, then the old holder slides out to one
+        self.release_hand(new_hold)
+        self.grip(new_hold, SIDE_DIR[new_hold.side], 2, "shift in", k, relation="cross")
+        self.release_hand(new_rot)
+        self.grip(new_rot, SIDE_DIR[new_rot.side], 1, "shift out", k)
+
+    def _handover(self, a: Handover, k: int) -> None:
+        giver, taker = self.hands[a.giver], self.hands[a.taker]
+        cfg = self.config
+        self.release_hand(taker, retreat=cfg.taker_retreat)
+        centre = self.est.p.copy()
+        n = max(1, cfg.handover_waypoints) * abs(a.quarter_turns)
+        angle = a.quarter_turns * math.pi / 2
+        start = giver.cmd
+        for i in range(1, n + 1):
+            self.send(
+                giver,
+                rotate_about_point(start, centre, a.axis, angle * i / n),
+                label="hand-over turn",
+                settle=0.05 if i < n else 0.2,
+            )
+        self._judge("hand-over turned", giver)
+        # The taker holds the cube alone while the giver comes round: with ``lone_holder_two_slabs``
+        # two slabs deep, whichever hand rotates next (a one-slab grip let the cube pivot about its
+        # pad axis: measured on PyBullet, 32 degrees as the giver let go); if the taker is then the
+        # next rotator, the giver re-grips two slabs deep as well (fingers crossing, as in a shift)
+        # and the taker slides out to one slab (_join).
+        depth = self._lone_depth(taker, a.rotator)
+        self.grip(
+            taker,
+            SIDE_DIR[taker.side],
+            depth,
+            "hand-over take",
+            k,
+            relation=self.grasp.take_relation(),
+            take=True,
+        )
+        self.release_hand(giver, retreat=cfg.handover_retreat)
+        self._judge("hand-over given", taker)
+        self._join(taker, giver, a.rotator, "hand-over re-grip", "hand-over shift out", k)
+
+    def _release(self) -> None:
+        for hand in self.hands.values():
+            self.grasp.open(self, hand)
+            hand.holding = False
+        self.t_release = self.b.time
