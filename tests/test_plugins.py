@@ -373,7 +373,8 @@ def _movable_joints(urdf: Path) -> set[str]:
     ],
 )
 def test_robot_meta_matches_config_and_urdf(name, module, config):
-    """DOF = the URDF's movable joints (an independent count), groups = the config's groups."""
+    """DOF = the URDF's movable joints (an independent count) less the fingertip joints a linkage
+    moves (the PR2's four-bar fingertips follow their fingers), groups = the config's groups."""
     import importlib
 
     from benchharness.paths import data_root
@@ -382,9 +383,11 @@ def test_robot_meta_matches_config_and_urdf(name, module, config):
     meta = get_manager(reload=True).get("robot", name).meta
     urdf = data_root() / meta["urdf"]
     assert urdf.resolve() == Path(cfg.urdf).resolve()
-    assert meta["dof"] == len(_movable_joints(urdf))
+    followers = {k.follower for g in cfg.grippers for k in g.linkages}
+    assert followers <= _movable_joints(urdf)
+    assert meta["dof"] == len(_movable_joints(urdf) - followers)
     assert meta["groups"] == list(cfg.groups())
-    assert {j for g in cfg.groups().values() for j in g} == _movable_joints(urdf)
+    assert {j for g in cfg.groups().values() for j in g} | followers == _movable_joints(urdf)
 
 
 def test_listing_robots_reads_configs_without_torch():
