@@ -78,14 +78,11 @@ def _soft(key: str, lower: float, upper: float) -> dict[str, float]:
 
 #: Gripper figures. The real finger is a parallelogram four-bar (pr2_description
 #: gripper_v0/gripper.urdf.xacro): ``*_l_finger_joint`` turns the proximal link by theta about z at
-#: FINGER_PIVOT, and ``*_l_finger_tip_joint`` (mimic +1, axis -z) turns the fingertip back by theta at
+#: (FINGER_X, FINGER_Y), and ``*_l_finger_tip_joint`` (mimic +1, axis -z) turns the fingertip back by theta at
 #: FINGER_TO_TIP along it, so the fingertip stays parallel to the palm while its origin travels on a
 #: circle of radius FINGER_RADIUS about the pivot. We model exactly that pad motion with two prismatic
 #: joints per finger (see :func:`_gripper`).
 GRIPPER_MAX_OPENING = 0.09  # m; l_gripper_joint upper="0.09" (gripper_v0/gripper.urdf.xacro)
-GRIPPER_UPPER_ANGLE = (
-    0.548  # rad; gripper_upper_angle (finger joint upper limit, gripper.urdf.xacro)
-)
 PAD_GAP = 0.001  # m; each pad's inner face sits this far out from the finger joint value (pads never interpenetrate)
 FINGER_TRAVEL = (GRIPPER_MAX_OPENING - 2 * PAD_GAP) / 2  # per finger
 TCP_X = 0.18  # m; l_gripper_tool_frame origin xyz="0.18 0 0" (pr2_description gripper_v0/gripper.urdf.xacro)
@@ -117,12 +114,6 @@ TIP_INERTIA = {
 FINGER_MASS = {"l": 0.17126, "r": 0.17389}  # kg, l/r_gripper_*_finger_link (gripper.urdf.xacro)
 
 
-def finger_angle(half_opening: float) -> float:
-    """The real finger joint angle (rad) at which each pad face is ``half_opening`` from the midline."""
-    s = (half_opening + PAD_FACE_Y - FINGER_Y) / FINGER_RADIUS
-    return math.asin(max(-1.0, min(1.0, s))) - math.atan2(FINGER_TO_TIP[1], FINGER_TO_TIP[0])
-
-
 def tip_x(half_opening: float) -> float:
     """Fingertip-frame origin along the approach (palm frame, m) with the pads ``half_opening`` out.
 
@@ -151,6 +142,16 @@ def _bar_length() -> float:
     return tip_x(FINGER_TRAVEL + PAD_GAP) + PAD_CENTRE_X - PAD_SIZE[0] / 2 - BAR_X0
 
 
+def _pad_centre(sign: float) -> tuple[float, float, float]:
+    """Centre of the pad box in its fingertip frame (``sign`` +1 left finger, -1 right)."""
+    return (PAD_CENTRE_X, sign * (PAD_SIZE[1] / 2 - PAD_FACE_Y), 0.0)
+
+
+def _bar_centre(sign: float) -> tuple[float, float, float]:
+    """Centre of the finger bar in its finger frame (level with the fingertip frame), outside the pad."""
+    return (BAR_X0 + _bar_length() / 2, sign * (PAD_SIZE[1] + 0.004 - PAD_FACE_Y), 0.0)
+
+
 def finger_boxes(
     opening: float,
 ) -> list[tuple[tuple[float, float, float], tuple[float, float, float]]]:
@@ -161,19 +162,14 @@ def finger_boxes(
     """
     h = opening / 2.0
     x_tip = tip_x(h)
-    bar = _bar_length()
+    bar_size = (_bar_length(), *BAR_SIZE_YZ)
     out = []
     for sign in (1.0, -1.0):
-        y_tip = sign * (h + PAD_FACE_Y)
-        out.append(
-            ((x_tip + PAD_CENTRE_X, y_tip + sign * (PAD_SIZE[1] / 2 - PAD_FACE_Y), 0.0), PAD_SIZE)
-        )
-        out.append(
-            (
-                (BAR_X0 + bar / 2, y_tip + sign * (PAD_SIZE[1] + 0.004 - PAD_FACE_Y), 0.0),
-                (bar, *BAR_SIZE_YZ),
-            )
-        )
+        y_tip = sign * (h + PAD_FACE_Y)  # the fingertip and finger frames' lateral position
+        px, py, pz = _pad_centre(sign)
+        bx, by, bz = _bar_centre(sign)
+        out.append(((x_tip + px, y_tip + py, pz), PAD_SIZE))
+        out.append(((bx, y_tip + by, bz), bar_size))
     return out
 
 
@@ -466,7 +462,7 @@ def _gripper(m: UrdfBuilder, s: str) -> None:
     # proximal bar, then a fingertip slide along the approach that the controller keeps at
     # tip_slide(half opening) (FingertipLinkage in robots/config.py): the pad face then is where the
     # real four-bar puts it at every opening, parallel to the palm, as the real mimic chain keeps it.
-    bar_len = _bar_length()
+    bar_size = (_bar_length(), *BAR_SIZE_YZ)
     for finger, sign in (("l", 1.0), ("r", -1.0)):
         m.joint(
             f"{s}_gripper_{finger}_finger_joint",
@@ -487,13 +483,7 @@ def _gripper(m: UrdfBuilder, s: str) -> None:
         )
         m.link(
             f"{s}_gripper_{finger}_finger_link",
-            [
-                Geom(
-                    "box",
-                    (bar_len, *BAR_SIZE_YZ),
-                    (BAR_X0 + bar_len / 2, sign * (PAD_SIZE[1] + 0.004 - PAD_FACE_Y), 0.0),
-                )
-            ],
+            [Geom("box", bar_size, _bar_centre(sign))],
             FINGER_MASS[finger],
             source=f"mass {FINGER_MASS[finger]} kg of {s}_gripper_{finger}_finger_link (gripper_v0/gripper.urdf.xacro); "
             "COM and inertia from the bar (the published ones are of the revolute proximal link)",
@@ -516,7 +506,7 @@ def _gripper(m: UrdfBuilder, s: str) -> None:
         )
         m.link(
             f"{s}_gripper_{finger}_finger_tip_link",
-            [Geom("box", PAD_SIZE, (PAD_CENTRE_X, sign * (PAD_SIZE[1] / 2 - PAD_FACE_Y), 0.0))],
+            [Geom("box", PAD_SIZE, _pad_centre(sign))],
             TIP_MASS,
             com=TIP_COM[finger],
             inertia=TIP_INERTIA[finger],
