@@ -68,11 +68,11 @@ def test_partial_tier_is_not_shown_as_a_score(invoke):
 
 
 def test_bad_names_exit_2_with_the_plugin_managers_message(invoke):
-    for opt, value, kind in (
-        ("--robot", "nope", "robot"),
-        ("--strategy", "nope", "strategy"),
-        ("--backend", "nope", "backend"),
-        ("--sensors", "a,nope", "sensor"),
+    for opt, value, kind, plural in (
+        ("--robot", "nope", "robot", "robots"),
+        ("--strategy", "nope", "strategy", "strategies"),
+        ("--backend", "nope", "backend", "backends"),
+        ("--sensors", "a,nope", "sensor", "sensors"),
     ):
         args = ["--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE]
         if opt in args:
@@ -81,7 +81,7 @@ def test_bad_names_exit_2_with_the_plugin_managers_message(invoke):
             args += [opt, value]
         r = invoke(run, *args)
         assert r.exit_code == 2, (opt, r.output)
-        assert f"no {kind} named" in r.output and "Available" in r.output
+        assert f"no {kind} named" in r.output and f"Available {plural}:" in r.output
     r = invoke(run, "--task", "Rubiks-9-9", "--strategy", "test-drop", *BASE)
     assert r.exit_code == 2 and "no task named 'Rubiks-9-9'" in r.output
     r = invoke(run, "--task", "Rubiks-1-5", "--strategy", "test-drop", *BASE, "--physics", "warp=1")

@@ -134,6 +134,11 @@ class PluginNotFoundError(LookupError):
     """No item of that kind and name is registered."""
 
 
+def _plural(kind: str) -> str:
+    """The plural of an item kind for messages ("strategy" -> "strategies")."""
+    return kind[:-1] + "ies" if kind.endswith("y") else kind + "s"
+
+
 def _entry_point_label(ep: metadata.EntryPoint) -> str:
     return f"{ep.name} = {ep.value}"
 
@@ -309,7 +314,7 @@ class PluginManager:
             pass
         available = ", ".join(sorted(self.names(kind))) or "(none)"
         msg = [
-            f"no {kind} named {name!r} is registered. Available {kind}s: {available}.",
+            f"no {kind} named {name!r} is registered. Available {_plural(kind)}: {available}.",
             f"Items are discovered through the {ENTRY_POINT_GROUP!r} entry-point group; "
             f"a distribution providing {name!r} must be installed and declare it under "
             f"[project.entry-points.{ENTRY_POINT_GROUP}].",
