@@ -28,6 +28,7 @@ Usage (from the repository root, the package importable)::
     python bench/bench_speed.py                       # the issue's default set
     python bench/bench_speed.py --only Rubiks-1-5 --backends sapien --repeats 3
     python bench/bench_speed.py --profile /tmp/prof   # one cProfile per trial
+    python bench/bench_speed.py --only '' --protocol --protocol-repeats 10   # `rubiks expect` alone
 """
 
 from __future__ import annotations
@@ -226,7 +227,9 @@ def main() -> None:
         _child(a.child, a.child_profile, a.rest)
         return
     rows = []
-    for label in a.only.split(","):
+    for label in filter(
+        None, a.only.split(",")
+    ):  # --only '' --protocol: the protocol command alone
         for be in a.backends.split(","):
             for rep in range(a.repeats):
                 for src in a.src or [None]:

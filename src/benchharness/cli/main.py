@@ -3,7 +3,17 @@
 from __future__ import annotations
 
 import importlib
+import os
 import sys
+
+# One BLAS thread unless the user says otherwise, set before NumPy is first
+# imported (``.common`` imports it). Our linear algebra is small (poses,
+# 7-joint Jacobians, Kalman updates), below the size where OpenBLAS splits
+# work over threads, so its thread pool only costs start-up: importing NumPy
+# with the default pool took 0.18 CPU-s here against 0.13 CPU-s with one
+# thread, which is what keeps ``rubiks expect`` over its 0.15 CPU-s target
+# (BENCHMARKS.md, issue 12). Trial worker processes inherit the setting.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import click
 
