@@ -203,6 +203,13 @@ class SweepConfig:
     #: Readings (on the face, and past the edge) that make a face and an edge: 3
     #: rejects a single outlier and keeps 1.2 mm of travel at the default spacing.
     min_run: int = 3
+    #: Shortest run (m of sensor travel) that counts as a face: 4 mm (10 readings at the default
+    #: spacing). Near an edge of a cube turned a few degrees the beam can graze the adjacent face for a
+    #: few readings, whose ranges then climb steeply; such a run must not make a second "edge".
+    min_face_length: float = 0.004
+    #: Steepest range slope (m of range per m of travel, fitted over a run) of a face: tan 60 degrees,
+    #: the filter's default ``max_incidence_deg``; a grazing face is steeper.
+    max_face_slope: float = 1.732
     #: Std (m) the beam's footprint adds to an edge's position. 0.5 mm: the model's
     #: beam is a ray (the real ~25 degree cone's return is dominated by its axis on a
     #: matte face), and a cone reports an edge somewhat early by an amount that varies
@@ -216,9 +223,11 @@ class SweepConfig:
             speed=self.speed,
             standoff=self.standoff,
             jump=self.jump,
+            max_face_slope=self.max_face_slope,
         )
         _check_nonneg(
             "SweepConfig",
+            min_face_length=self.min_face_length,
             overshoot=self.overshoot,
             face_depth=self.face_depth,
             vertical_offset=self.vertical_offset,

@@ -25,6 +25,10 @@ is handled alike (the box's symmetry only matters if the belief is 45° off).
   other than the ranged one whose normal is most nearly along the sweep,
   pointing the way the beam left the face (or against the way it came on).
 
+The rotation columns above are for a small turn on the left of the current
+estimate; the filter multiplies them by the SO(3) left Jacobian of ``δθ``
+(:func:`left_jacobian`) so that they are derivatives in the state itself.
+
 **Update** (:meth:`CubePose6Filter.update`): an iterated EKF over the whole
 batch — Gauss–Newton on the MAP objective, relinearised at each iterate,
 with the same gates as :class:`.cube_filter.CubePoseFilter` (no return,
@@ -49,7 +53,15 @@ from .pose_estimate import PoseEstimate
 from .raybox import ray_box
 from .sweep import EdgeObservation
 
-__all__ = ["POSE6_AXES", "CubePose6Filter", "Update6Report", "edge_model", "range_model"]
+__all__ = [
+    "POSE6_AXES",
+    "CubePose6Filter",
+    "Update6Report",
+    "compose",
+    "edge_model",
+    "left_jacobian",
+    "range_model",
+]
 
 #: Covariance axes of the 6-DOF filter: centre offset (m) and rotation vector about the belief (rad).
 POSE6_AXES: tuple[str, ...] = ("x", "y", "z", "rx", "ry", "rz")
@@ -60,6 +72,21 @@ def compose(nominal: Pose, x: np.ndarray) -> Pose:
     """The pose ``nominal ⊕ x``: centre moved by ``x[:3]``, turned by ``x[3:]`` (world) about it."""
     x = np.asarray(x, dtype=float).reshape(_DIM)
     return Pose.from_rotation(nominal.p + x[:3], Rotation.from_rotvec(x[3:]) * nominal.rotation)
+
+
+def left_jacobian(phi: np.ndarray) -> np.ndarray:
+    """SO(3) left Jacobian: ``Rot(φ + ε) ≈ Rot(J_l(φ) ε) Rot(φ)``.
+
+    The models' rotation columns are derivatives with respect to a small turn
+    applied on the left of the current estimate; times ``J_l(δθ)`` they become
+    derivatives with respect to the state's rotation vector itself.
+    """
+    phi = np.asarray(phi, dtype=float).reshape(3)
+    th = float(np.linalg.norm(phi))
+    k = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
+    if th < 1e-6:
+        return np.eye(3) + 0.5 * k
+    return np.eye(3) + (1 - math.cos(th)) / th**2 * k + (th - math.sin(th)) / th**3 * (k @ k)
 
 
 def range_model(
@@ -213,10 +240,12 @@ class CubePose6Filter:
         var.append(ve)
         ok.append(oke)
         del n_r
+        jac_all = np.concatenate(jac, axis=0).reshape(-1, _DIM)
+        jac_all[:, 3:] = jac_all[:, 3:] @ left_jacobian(xi[3:])
         return (
             np.concatenate(meas),
             np.concatenate(pred),
-            np.concatenate(jac, axis=0).reshape(-1, _DIM),
+            jac_all,
             np.concatenate(var),
             np.concatenate(ok),
             returned,

@@ -19,7 +19,9 @@ Rules (each with why):
 * readings group into *runs* of consecutive returns whose ranges differ by
   less than ``jump`` (10 mm: ~7 σ of the VL6180X's range noise, and under
   the 57 mm face a beam can only step off); a face is a run of at least
-  ``min_run`` readings;
+  ``min_run`` readings over at least ``min_face_length`` of travel whose
+  fitted range slope is at most ``max_face_slope`` (a few readings grazing the
+  adjacent face of a turned cube are neither);
 * an edge is a face run's end next to at least ``min_run`` readings with no
   return (inf) or ranges more than ``jump`` *farther*; NaN (too close, or a
   reading the caller masked) is neither face nor beyond; a neighbour that is nearer is
@@ -107,7 +109,17 @@ def find_edges(
     if excl.shape != z.shape:
         raise ValueError(f"exclude must have shape {z.shape}, got {excl.shape}")
     runs = _runs(z, cfg.jump, excl)
-    faces = [r for r in runs if r[1] - r[0] >= n_min]
+
+    def is_face(a: int, b: int) -> bool:
+        if b - a < n_min:
+            return False
+        s = (o[a:b] - o[a]) @ (o[b - 1] - o[a]) / max(float(np.linalg.norm(o[b - 1] - o[a])), 1e-12)
+        if s[-1] < cfg.min_face_length:
+            return False
+        slope = np.polyfit(s, z[a:b], 1)[0]
+        return bool(abs(slope) <= cfg.max_face_slope)
+
+    faces = [r for r in runs if is_face(*r)]
 
     def far_side(face_range: float, idx: range) -> bool:
         """``idx`` (at least min_run readings) all without a return or farther than the face by ``jump``."""
