@@ -181,9 +181,11 @@ class SweepConfig:
     #: (its datasheet's typical convergence time plus readout), so ~50-60 Hz is its
     #: continuous-mode ceiling.
     rate_hz: float = 50.0
-    #: Fingertip speed along a sweep (m/s). 20 mm/s puts readings 0.4 mm apart at
-    #: 50 Hz: an edge quantised to 0.12 mm (std), well under the range noise.
-    speed: float = 0.02
+    #: Fingertip speed along a sweep (m/s). 40 mm/s puts readings 0.8 mm apart at
+    #: 50 Hz: an edge quantised to 0.23 mm (std), under the beam's 0.5 mm and the
+    #: range noise; twice as slow halved the edge std's quantisation part only and
+    #: doubled the sweeps' ~3.4 s per grasp.
+    speed: float = 0.04
     #: Gap (m) from the believed face to the emitter window while sweeping: 30 mm is
     #: mid-window for a 5-100 mm ranger, so a centimetre of pose error either way
     #: stays in range.
@@ -192,7 +194,7 @@ class SweepConfig:
     #: dead-reckoning error with margin, and leaves ``min_run`` readings past the edge.
     overshoot: float = 0.012
     #: How far (m) a vertical sweep reaches down the face from the top edge: 15 mm
-    #: of face readings (37 at the default spacing) to range and to fit the slope.
+    #: of face readings (19 at the default spacing) to range and to fit the slope.
     face_depth: float = 0.015
     #: Lateral offset (m) of the two vertical sweeps from the face centre (either
     #: side): their top-edge heights 24 mm apart give the rotation about the work axis.
@@ -201,9 +203,9 @@ class SweepConfig:
     #: ~7 sigma of the range noise, and nothing but an edge steps that far on a flat face.
     jump: float = 0.010
     #: Readings (on the face, and past the edge) that make a face and an edge: 3
-    #: rejects a single outlier and keeps 1.2 mm of travel at the default spacing.
+    #: rejects a single outlier and keeps 2.4 mm of travel at the default spacing.
     min_run: int = 3
-    #: Shortest run (m of sensor travel) that counts as a face: 4 mm (10 readings at the default
+    #: Shortest run (m of sensor travel) that counts as a face: 4 mm (5 readings at the default
     #: spacing). Near an edge of a cube turned a few degrees the beam can graze the adjacent face for a
     #: few readings, whose ranges then climb steeply; such a run must not make a second "edge".
     min_face_length: float = 0.004
