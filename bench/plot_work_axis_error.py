@@ -84,11 +84,14 @@ def main(argv: list[str] | None = None) -> int:
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
     jitter = 0.12
+    worst: dict[str, dict[int, float]] = {"dr": {}, "sa": {}}
     for k, (status, d) in enumerate(_trials(a.dead_reckoning, a.task, "dead-reckoning")):
         xs, ys = dead_reckoning_points(d)
         off = -jitter + 0.02 * k
-        ax.plot([x + off for x in xs], ys, "-o", ms=3, lw=0.8, color="tab:red", alpha=0.7,
+        ax.plot([x + off for x in xs], ys, "o", ms=3, color="tab:red", alpha=0.6,
                 label="dead reckoning (after each action)" if k == 0 else None)  # fmt: skip
+        for x, y in zip(xs, ys):
+            worst["dr"][x] = max(worst["dr"].get(x, 0.0), y)
         if status != "success" and xs:
             ax.plot([xs[-1] + off], [ys[-1]], "x", ms=9, mew=2, color="tab:red")
     for k, (status, d) in enumerate(_trials(a.sensor_aided, a.task, "sensor-aided")):
@@ -98,15 +101,22 @@ def main(argv: list[str] | None = None) -> int:
                 label="sensor-aided, dead-reckoned before the sweeps" if k == 0 else None)  # fmt: skip
         ax.plot([x + off for x in xs], after, "o", ms=3, color="tab:blue",
                 label="sensor-aided, after the sweeps (each grasp)" if k == 0 else None)  # fmt: skip
+        for x, y in zip(xs, after):
+            worst["sa"][x] = max(worst["sa"].get(x, 0.0), y)
         if status != "success" and xs:
             ax.plot([xs[-1] + off], [after[-1]], "x", ms=9, mew=2, color="tab:blue")
+    for key, colour, off in (("dr", "tab:red", -jitter), ("sa", "tab:blue", jitter)):
+        pts = sorted(worst[key].items())
+        if pts:
+            ax.plot([x + off for x, _ in pts], [y for _, y in pts], "-", lw=1, color=colour,
+                    label="worst per move" if key == "sa" else None)  # fmt: skip
     ax.axhline(HALF_CUBIE_MM, color="k", ls="--", lw=1)
-    ax.text(0.0, HALF_CUBIE_MM + 0.3, "half a cubie (9.5 mm)", fontsize=8)
+    ax.text(-0.2, HALF_CUBIE_MM + 0.3, "half a cubie (9.5 mm)", fontsize=8)
     ax.set_xlabel("move index (twists done)")
     ax.set_ylabel("|belief error| along work axis (mm)")
     ax.set_title(a.title or f"{a.task or ''} work-axis belief error per grasp (x: failed trial)")
     ax.set_ylim(bottom=0)
-    ax.legend(fontsize=7, loc="upper left")
+    ax.legend(fontsize=7, loc="center right", framealpha=0.9)
     fig.tight_layout()
     a.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(a.out)

@@ -227,8 +227,9 @@ class PR2SensorAidedGrasp(PR2Grasp):
     """The PR2 grasp module plus pre-touch re-localisation before every grasp (Yang et al. 2020, Sec. IV-B).
 
     ``pretouch_mode="sweep"`` (default; Yang et al., ICRA 2017): at each
-    pre-grasp the hand moves its fingertip ToF sensor (one emitter on the left
-    fingertip, looking along the approach; ``benchharness.sensors``
+    pre-grasp the hand moves a fingertip ToF sensor (one emitter in each
+    fingertip, looking along the approach; each sweep uses the fingertip that
+    keeps the hand nearer its pre-grasp, or the other if the arm cannot start it; ``benchharness.sensors``
     ``PreTouchSensor``, rays cast from the true fingertip and reported from the
     believed one) in three sweeps across the face it is about to grip: one
     across the face at mid-height past both side edges, two up and down over
@@ -255,12 +256,17 @@ class PR2SensorAidedGrasp(PR2Grasp):
             raise ValueError(
                 f"pretouch_mode must be 'sweep' or 'grid', got {self.config.pretouch_mode!r}"
             )
-        self._sensors: dict[str, tuple[Any, np.random.Generator]] = {}
+        self._sensors: dict[tuple[str, str], tuple[Any, np.random.Generator]] = {}
 
-    def _sensor(self, m: BimanualRubiksMachine, hand: Hand) -> tuple[Any, np.random.Generator]:
+    def _sensor(
+        self, m: BimanualRubiksMachine, hand: Hand, finger: str = "l"
+    ) -> tuple[Any, np.random.Generator]:
+        """The pre-touch sensor (and its random stream) of ``hand``'s ``finger`` ("l" or "r") fingertip;
+        in grid mode the one tool-frame grid whatever ``finger``. Created on first use."""
         from ...sensors import Emitter, PreTouchSensor
 
-        if hand.side not in self._sensors:
+        key = (hand.side, finger if self.config.pretouch_mode == "sweep" else "tool")
+        if key not in self._sensors:
             cfg = self.config
             body = m.robot.body
             tcp = hand.arm.config.tcp_link
@@ -270,10 +276,10 @@ class PR2SensorAidedGrasp(PR2Grasp):
                 emitters = [Emitter((0.0, y, z), (1.0, 0.0, 0.0)) for y in grid for z in grid]
                 link = tcp
             else:
-                # one emitter in the left fingertip, its window at the pad's front end (the pad runs
+                # one emitter in each fingertip, its window at the pad's front end (the pad runs
                 # to x = 31.25 mm in the fingertip frame), looking along the approach (the fingertip
                 # stays parallel to the palm on the four-bar)
-                link = tcp.replace("gripper_tcp", "gripper_l_finger_tip_link")
+                link = tcp.replace("gripper_tcp", f"gripper_{finger}_finger_tip_link")
                 emitters = [Emitter((0.032, 0.0, 0.0), (1.0, 0.0, 0.0), "fingertip")]
                 if cfg.pretouch_see_robot:
                     kw = {"ignore_bodies": (), "ignore_links": ((body, link),)}
@@ -284,8 +290,8 @@ class PR2SensorAidedGrasp(PR2Grasp):
             else:
                 sensor = PreTouchSensor(m.b, body, link, emitters, **kw)
                 rng = np.random.default_rng(m.ctx.rng.integers(2**63))
-            self._sensors[hand.side] = (sensor, rng)
-        return self._sensors[hand.side]
+            self._sensors[key] = (sensor, rng)
+        return self._sensors[key]
 
     def relocalise(self, m: BimanualRubiksMachine, hand: Hand, grip: Pose, label: str) -> Pose:
         if self.config.pretouch_mode == "grid":
@@ -428,35 +434,58 @@ class PR2SensorAidedGrasp(PR2Grasp):
         from ...sensors.pose_estimate import PoseEstimate
 
         cfg, sw, b = self.config, self.config.sweep, m.b
-        sensor, rng = self._sensor(m, hand)
+        sensors = {f: self._sensor(m, hand, f) for f in ("l", "r")}
         t0 = b.time
         pre = hand.cmd  # the pre-grasp, where the hand comes back to
         q_pre = hand.arm.positions()
-        # the emitter in the tool frame, from the joint encoders (forward kinematics; the hand is open)
-        tool_to_tip = hand.arm.tcp_pose().inv() * sensor.link_pose()
-        window = tool_to_tip.apply(np.asarray(sensor.emitters[0].origin, dtype=float))
+        # each fingertip's window in the tool frame, from the joint encoders (forward kinematics; the
+        # hand is open)
+        tcp_now = hand.arm.tcp_pose()
+        windows = {
+            f: (tcp_now.inv() * s.link_pose()).apply(np.asarray(s.emitters[0].origin, dtype=float))
+            for f, (s, _) in sensors.items()
+        }
         approach = grip.rotation.apply(along(self.approach_axis, 1.0))
 
-        def tool_at(point: np.ndarray) -> Pose:
-            return Pose(point - grip.rotation.apply(window), grip.q)
+        def tool_at(point: np.ndarray, f: str) -> Pose:
+            return Pose(point - grip.rotation.apply(windows[f]), grip.q)
 
         dt = float(b.config.timestep)
         every = max(1, round(1.0 / (sw.rate_hz * dt)))
         origins, directions, ranges, edges = [], [], [], []
         done, skipped = [], []
         for name, start, end in self._sweep_plan(m.est, approach):
-            a_pose, b_pose = tool_at(start), tool_at(end)
-            if not (m._smooth(hand, a_pose)):
+            # the fingertip whose sweep keeps the hand nearer the pre-grasp first, the other if the arm
+            # cannot start it smoothly (a sweep to the far side of the cube can leave the arm's reach)
+            order = sorted(
+                ("l", "r"),
+                key=lambda f: max(
+                    float(np.linalg.norm(tool_at(p, f).p - pre.p)) for p in (start, end)
+                ),
+            )
+            finger = next((f for f in order if m._smooth(hand, tool_at(start, f))), None)
+            if finger is None:
                 skipped.append(name)
                 continue
-            m.send(hand, a_pose, label=f"{label} pre-touch {name} start", settle=0.05)
+            sensor, rng = sensors[finger]
+            a_pose, b_pose = tool_at(start, finger), tool_at(end, finger)
+            try:
+                m.send(hand, a_pose, label=f"{label} pre-touch {name} start", settle=0.05)
+            except StrategyFailure:  # the injected errors put the target just out of reach
+                skipped.append(name)
+                continue
             if not m._smooth(hand, b_pose):
                 skipped.append(name)
                 continue
             got: list[Any] = []
             tick = [0]
 
-            def read(got: list[Any] = got, tick: list[int] = tick) -> None:
+            def read(
+                got: list[Any] = got,
+                tick: list[int] = tick,
+                sensor: Any = sensor,
+                rng: np.random.Generator = rng,
+            ) -> None:
                 tick[0] += 1
                 if tick[0] % every:
                     return
@@ -471,9 +500,12 @@ class PR2SensorAidedGrasp(PR2Grasp):
                     duration=float(np.linalg.norm(end - start)) / sw.speed,
                     settle=0.0,
                 )
+            except StrategyFailure:  # as above: the sweep's end just out of reach; not used
+                got.clear()
             finally:
                 b.remove_step_callback(handle)
             if not got:
+                skipped.append(name)
                 continue
             o = np.concatenate([r.origins for r in got])
             d = np.concatenate([r.directions for r in got])
@@ -483,7 +515,7 @@ class PR2SensorAidedGrasp(PR2Grasp):
             directions.append(d)
             ranges.append(np.where(own, np.nan, z))  # the robot's own returns are not fused
             edges += find_edges(o, d, z, config=sw, tof=sensor.config, exclude=own)
-            done.append(name)
+            done.append(f"{name}({finger})")
         m.send(hand, pre, label=f"{label} pre-grasp", settle=0.1, seed_q=q_pre)
         cost = b.time - t0
 
@@ -496,7 +528,7 @@ class PR2SensorAidedGrasp(PR2Grasp):
         before = m.est
         kf = CubePose6Filter(
             PoseEstimate(before, np.diag(std**2), n_measurements=1, time=t0, axes=POSE6_AXES),
-            tof=sensor.config,
+            tof=sensors["l"][0].config,
         )
         rep = kf.update(
             np.concatenate(origins) if origins else None,
