@@ -554,6 +554,11 @@ class PR2SensorAidedGrasp(PR2Grasp):
 
         w0, p0, r0 = errors(before)
         w1, p1, r1 = errors(m.est)
+        # the same after the sweeps against the truth as this arm's kinematic model sees it (its
+        # calibration offset removed, for the record only): what its grip depends on, and what the
+        # posterior std describes
+        cal = hand.calibration
+        dp_hand = m.est.p - (true.p - cal.p)
         post_std = np.sqrt(np.diag(kf.P))
         m.ctx.recorder.event(
             "pretouch",
@@ -572,6 +577,8 @@ class PR2SensorAidedGrasp(PR2Grasp):
             work_axis=np.round(approach, 3).tolist(),
             work_err_mm_before=w0,
             work_err_mm=w1,
+            work_err_hand_mm=round(1000 * float(dp_hand @ approach), 3),
+            err_hand_mm=np.round(1000 * dp_hand, 3).tolist(),
             err_mm_before=p0,
             err_mm=p1,
             rot_err_deg_before=r0,
