@@ -29,6 +29,12 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 HALF_CUBIE_MM = 9.5
+#: top of the y axis (mm); larger errors (a dropped cube) are drawn at it as a triangle
+Y_MAX = 14.0
+
+
+def _clip(ys: list[float]) -> list[float]:
+    return [min(y, Y_MAX) for y in ys]
 
 
 def _trials(store: Path, task: str | None, strategy: str) -> list[tuple[str, dict]]:
@@ -88,34 +94,44 @@ def main(argv: list[str] | None = None) -> int:
     for k, (status, d) in enumerate(_trials(a.dead_reckoning, a.task, "dead-reckoning")):
         xs, ys = dead_reckoning_points(d)
         off = -jitter + 0.02 * k
-        ax.plot([x + off for x in xs], ys, "o", ms=3, color="tab:red", alpha=0.6,
+        ax.plot([x + off for x in xs], _clip(ys), "o", ms=3, color="tab:red", alpha=0.6,
                 label="dead reckoning (after each action)" if k == 0 else None)  # fmt: skip
         for x, y in zip(xs, ys):
-            worst["dr"][x] = max(worst["dr"].get(x, 0.0), y)
+            if y <= Y_MAX:
+                worst["dr"][x] = max(worst["dr"].get(x, 0.0), y)
         if status != "success" and xs:
-            ax.plot([xs[-1] + off], [ys[-1]], "x", ms=9, mew=2, color="tab:red")
+            ax.plot([xs[-1] + off], [min(ys[-1], Y_MAX)], "x", ms=9, mew=2, color="tab:red")
     for k, (status, d) in enumerate(_trials(a.sensor_aided, a.task, "sensor-aided")):
         xs, after, before = sensor_aided_points(d)
         off = jitter + 0.02 * k
-        ax.plot([x + off for x in xs], before, ".", ms=3, color="tab:blue", alpha=0.25,
+        ax.plot([x + off for x in xs], _clip(before), ".", ms=3, color="tab:blue", alpha=0.25,
                 label="sensor-aided, dead-reckoned before the sweeps" if k == 0 else None)  # fmt: skip
-        ax.plot([x + off for x in xs], after, "o", ms=3, color="tab:blue",
+        ax.plot([x + off for x in xs], _clip(after), "o", ms=3, color="tab:blue",
                 label="sensor-aided, after the sweeps (each grasp)" if k == 0 else None)  # fmt: skip
+        big = [(x, y) for x, y in zip(xs, after) if y > Y_MAX]
+        if big:
+            ax.plot([x + off for x, _ in big], [Y_MAX] * len(big), "^", ms=7, color="tab:blue")
         for x, y in zip(xs, after):
-            worst["sa"][x] = max(worst["sa"].get(x, 0.0), y)
+            if (
+                y <= Y_MAX
+            ):  # an off-scale point is a dropped cube, not a belief: drawn, not in the line
+                worst["sa"][x] = max(worst["sa"].get(x, 0.0), y)
         if status != "success" and xs:
-            ax.plot([xs[-1] + off], [after[-1]], "x", ms=9, mew=2, color="tab:blue")
+            ax.plot([xs[-1] + off], [min(after[-1], Y_MAX)], "x", ms=9, mew=2, color="tab:blue")
     for key, colour, off in (("dr", "tab:red", -jitter), ("sa", "tab:blue", jitter)):
         pts = sorted(worst[key].items())
         if pts:
-            ax.plot([x + off for x, _ in pts], [y for _, y in pts], "-", lw=1, color=colour,
-                    label="worst per move" if key == "sa" else None)  # fmt: skip
+            ax.plot([x + off for x, _ in pts], _clip([y for _, y in pts]), "-", lw=1, color=colour,
+                    label="worst per move (on scale)" if key == "sa" else None)  # fmt: skip
     ax.axhline(HALF_CUBIE_MM, color="k", ls="--", lw=1)
     ax.text(-0.2, HALF_CUBIE_MM + 0.3, "half a cubie (9.5 mm)", fontsize=8)
     ax.set_xlabel("move index (twists done)")
     ax.set_ylabel("|belief error| along work axis (mm)")
-    ax.set_title(a.title or f"{a.task or ''} work-axis belief error per grasp (x: failed trial)")
-    ax.set_ylim(bottom=0)
+    ax.set_title(
+        a.title
+        or f"{a.task or ''} work-axis belief error per grasp (x: failed trial, ^: off scale)"
+    )
+    ax.set_ylim(0, Y_MAX + 0.5)
     ax.legend(fontsize=7, loc="center right", framealpha=0.9)
     fig.tight_layout()
     a.out.parent.mkdir(parents=True, exist_ok=True)
