@@ -182,3 +182,43 @@ def test_twisting_pose_keeps_every_planned_grip_and_turn_inside_the_soft_limits(
         assert old["turn_z"][0] == float("-inf")
     finally:
         b.close()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_sensor_aided_pick_sweeps_the_fingertip_across_the_face_edges(make_ctx, backend):
+    """The pick alone, default errors: the picking hand really sweeps its fingertip sensor across the
+    face's side and top edges before it grips, and the 6-DOF filter puts the belief within a millimetre or
+    two of the truth on every axis (the arm's 1.5 mm calibration offset included) with a sub-millimetre std."""
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
+
+    ctx, b = make_ctx(backend, "R")
+    st = SensorAidedStrategy(replace(PR2RubiksConfig(), max_actions=1))
+    out = st.run_trial(ctx)
+    assert out.failure is None, out.message
+    pre = [e for e in ctx.recorder.events if e["kind"] == "pretouch"]
+    first = pre[0]
+    assert first["label"] == "pick" and first["mode"] == "sweep"
+    assert [s.split("(")[0] for s in first["sweeps"]] == ["across", "up", "down"]
+    assert first["edges_used"] >= 3 and first["used"] > 60
+    assert 6.0 < first["cost_s"] < 12.0  # the sweeps take simulated time
+    assert all(s < 1.0 for s in first["std_mm"]) and all(s < 2.0 for s in first["std_deg"])
+    assert all(abs(e) < 3.0 for e in first["err_mm"]), first
+    assert all(abs(e) < 3.0 for e in first["rot_err_deg"]), first
+    assert abs(first["work_err_mm"]) < 2.5
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_sensor_aided_completes_rubiks_1_5_with_default_errors(tmp_path, backend):
+    """A whole Rubiks-1-5 with the default injected errors: sweeps before every grasp, every grasp made
+    from a belief within half a cubie (9.5 mm) of the truth along the work axis, the trial solved."""
+    proc, rows = _run_cli(tmp_path, "sensor-aided", backend)
+    assert len(rows) == 1, proc.stderr[-2000:]
+    status, cause, message, score, sim_s, diag = rows[0]
+    assert status == "success", (status, cause, message)
+    d = json.loads(diag)
+    pre = [e for e in d["events"] if e["kind"] == "pretouch"]
+    assert len(pre) >= 10  # the pick, the second grasp, and every regrasp and hand-over grip after
+    assert all(e["mode"] == "sweep" and e["cost_s"] > 3.0 for e in pre)
+    assert all(abs(e["work_err_mm"]) < 9.5 for e in pre), [e["work_err_mm"] for e in pre]

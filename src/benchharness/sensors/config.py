@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["CubeFilterConfig", "HeadCameraConfig", "ToFConfig"]
+__all__ = ["CubeFilterConfig", "HeadCameraConfig", "SweepConfig", "ToFConfig"]
 
 
 def _check_nonneg(owner: str, **values: float) -> None:
@@ -166,3 +166,81 @@ class CubeFilterConfig:
             process_yaw_std_per_deg=self.process_yaw_std_per_deg,
             edge_margin=self.edge_margin,
         )
+
+
+@dataclass(frozen=True)
+class SweepConfig:
+    """How a fingertip ToF sweep is run and read (:mod:`.sweep`, the PR2's sensor-aided grasps).
+
+    The sensor moves at a constant speed and ranges at a fixed rate, so the
+    spacing of the readings along the sweep (speed / rate) bounds how well an
+    edge is placed; the beam's footprint adds its own blur.
+    """
+
+    #: Ranging rate (Hz). 50 Hz: the VL6180X's single-shot ranging takes ~10-15 ms
+    #: (its datasheet's typical convergence time plus readout), so ~50-60 Hz is its
+    #: continuous-mode ceiling.
+    rate_hz: float = 50.0
+    #: Fingertip speed along a sweep (m/s). 40 mm/s puts readings 0.8 mm apart at
+    #: 50 Hz: an edge quantised to 0.23 mm (std), under the beam's 0.5 mm and the
+    #: range noise; twice as slow halved the edge std's quantisation part only and
+    #: doubled the sweeps' ~3.4 s per grasp.
+    speed: float = 0.04
+    #: Gap (m) from the believed face to the emitter window while sweeping: 30 mm is
+    #: mid-window for a 5-100 mm ranger, so a centimetre of pose error either way
+    #: stays in range.
+    standoff: float = 0.03
+    #: How far (m) a sweep runs past each believed edge: 12 mm covers the ~6 mm
+    #: dead-reckoning error with margin, and leaves ``min_run`` readings past the edge.
+    overshoot: float = 0.012
+    #: How far (m) a vertical sweep reaches down the face from the top edge: 15 mm
+    #: of face readings (19 at the default spacing) to range and to fit the slope.
+    face_depth: float = 0.015
+    #: Lateral offset (m) of the two vertical sweeps from the face centre (either
+    #: side): their top-edge heights 24 mm apart give the rotation about the work axis.
+    vertical_offset: float = 0.012
+    #: Range step (m) that separates the face from what lies beyond its edge. 10 mm:
+    #: ~7 sigma of the range noise, and nothing but an edge steps that far on a flat face.
+    jump: float = 0.010
+    #: Readings (on the face, and past the edge) that make a face and an edge: 3
+    #: rejects a single outlier and keeps 2.4 mm of travel at the default spacing.
+    min_run: int = 3
+    #: Shortest run (m of sensor travel) that counts as a face: 4 mm (5 readings at the default
+    #: spacing). Near an edge of a cube turned a few degrees the beam can graze the adjacent face for a
+    #: few readings, whose ranges then climb steeply; such a run must not make a second "edge".
+    min_face_length: float = 0.004
+    #: Steepest range slope (m of range per m of travel, fitted over a run) of a face: tan 60 degrees,
+    #: the filter's default ``max_incidence_deg``; a grazing face is steeper.
+    max_face_slope: float = 1.732
+    #: Std (m) the beam's footprint adds to an edge's position. 0.5 mm: the model's
+    #: beam is a ray (the real ~25 degree cone's return is dominated by its axis on a
+    #: matte face), and a cone reports an edge somewhat early by an amount that varies
+    #: with reflectance; 0.5 mm is a guess of that spread, not a datasheet figure.
+    edge_std: float = 0.0005
+
+    def __post_init__(self) -> None:
+        _check_pos(
+            "SweepConfig",
+            rate_hz=self.rate_hz,
+            speed=self.speed,
+            standoff=self.standoff,
+            jump=self.jump,
+            max_face_slope=self.max_face_slope,
+        )
+        _check_nonneg(
+            "SweepConfig",
+            min_face_length=self.min_face_length,
+            overshoot=self.overshoot,
+            face_depth=self.face_depth,
+            vertical_offset=self.vertical_offset,
+            edge_std=self.edge_std,
+        )
+        if int(self.min_run) != self.min_run or self.min_run < 1:
+            raise ValueError(
+                f"SweepConfig.min_run must be a positive integer, got {self.min_run!r}"
+            )
+
+    @property
+    def spacing(self) -> float:
+        """Distance (m) between readings along a sweep."""
+        return self.speed / self.rate_hz

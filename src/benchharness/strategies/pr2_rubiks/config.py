@@ -9,10 +9,11 @@ the strategy's own mistakes from injected ones).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ...cube_physics.config import CubeConfig
 from ...robots.descriptions.pr2 import PAD_SIZE, pad_setback
+from ...sensors.config import SweepConfig
 from ..bimanual.config import BimanualConfig
 from ..error_sources import ErrorConfig
 
@@ -89,6 +90,18 @@ class PR2RubiksConfig(BimanualConfig):
     #: (m) and yaw (deg): of the order of the head camera's error (4 mm, 3 deg) that dead reckoning carries.
     pretouch_prior_pos_std: float = 0.006
     pretouch_prior_yaw_std_deg: float = 3.0
+    #: pre-touch (sensor-aided): std of the prior's roll, pitch and yaw about the believed pose in the 6-DOF
+    #: sweep mode (deg): the hand-over turns and grips tilt the cube by a degree or two as well as turning it.
+    pretouch_prior_tilt_std_deg: float = 2.0
+    #: pre-touch (sensor-aided): "sweep" (Yang et al.: the fingertip sensor swept across the face's edges
+    #: before every grasp, a 6-DOF filter; docs/sensors.md, "Sweeps") or "grid" (the former simplification:
+    #: one 3 x 3 ray grid along the approach from the pre-grasp, position and yaw only).
+    pretouch_mode: str = "sweep"
+    #: pre-touch sweeps: rate, speed, stand-off, extents and edge detection (docs/sensors.md).
+    sweep: SweepConfig = field(default_factory=SweepConfig)
+    #: pre-touch sweeps: whether the rays see the robot (only the emitting fingertip is transparent); False:
+    #: the whole robot is transparent to its own sensors (the grid mode's simplification).
+    pretouch_see_robot: bool = True
     #: pre-touch (sensor-aided): the 3 x 3 emitter grid across the tool frame (m, tool y and z), all
     #: looking along tool x: 12 mm apart, well inside the 57 mm face the hand approaches.
     pretouch_grid: tuple[float, ...] = (-0.012, 0.0, 0.012)

@@ -19,8 +19,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
-from ..bimanual.frames import DIRECTIONS, grip_candidates
+from ..bimanual.frames import DIRECTIONS, along, grip_candidates
 from ..bimanual.machine import (
+    CUBE_HALF,
     BimanualRubiksMachine,
     GripRequest,
     Hand,
@@ -225,40 +226,81 @@ class PR2Grasp:
 class PR2SensorAidedGrasp(PR2Grasp):
     """The PR2 grasp module plus pre-touch re-localisation before every grasp (Yang et al. 2020, Sec. IV-B).
 
-    Simplified: at each pre-grasp stand-off the approaching hand reads a 3 x 3
-    grid of time-of-flight rays fixed to its tool frame, looking along the
-    approach at the face it is about to grip (``benchharness.sensors``
-    ``PreTouchSensor``, rays cast from the true tool pose, reported from the
-    *commanded* one); an iterated EKF (``CubePoseFilter``) started from the
-    believed pose fuses them; the believed pose takes the filter's position and
-    yaw correction, the holding hand's belief is re-anchored to it, and the
-    grip is recomputed from the corrected belief. No sweep: one face along the
-    work axis is observed, which is the axis along which a grip lands on the
-    wrong slab.
+    ``pretouch_mode="sweep"`` (default; Yang et al., ICRA 2017): at each
+    pre-grasp the hand moves a fingertip ToF sensor (one emitter in each
+    fingertip, looking along the approach; each sweep uses the fingertip that
+    keeps the hand nearer its pre-grasp, or the other if the arm cannot start it; ``benchharness.sensors``
+    ``PreTouchSensor``, rays cast from the true fingertip and reported from the
+    believed one) in three sweeps across the face it is about to grip: one
+    across the face at mid-height past both side edges, two up and down over
+    the top edge at either side of the centre (:meth:`_sweep_plan`). The arm
+    really moves (the sweeps cost simulated time), the sensor ranges at
+    ``sweep.rate_hz`` while it does, and :func:`~benchharness.sensors.find_edges`
+    finds where the beam steps off the face. A 6-DOF iterated EKF
+    (:class:`~benchharness.sensors.pose6.CubePose6Filter`) started from the
+    believed pose fuses the face ranges (along the work axis, the two tilts)
+    and the edges (across the work axis, the height, the turn about the work
+    axis); the belief takes the posterior pose, the holding hand's belief is
+    re-anchored to it, and the grip is recomputed from it. Recorded per grasp
+    as a ``pretouch`` event (belief error against the truth, for the record
+    only, and the posterior std).
+
+    ``pretouch_mode="grid"``: the former simplification, a 3 x 3 grid of rays
+    along the approach from the tool frame read once at the pre-grasp
+    (position and yaw only; the robot transparent to them).
     """
 
     def __init__(self, config: PR2RubiksConfig | None = None) -> None:
         super().__init__(config)
-        self._sensors: dict[str, tuple[Any, np.random.Generator]] = {}
+        if self.config.pretouch_mode not in ("sweep", "grid"):
+            raise ValueError(
+                f"pretouch_mode must be 'sweep' or 'grid', got {self.config.pretouch_mode!r}"
+            )
+        self._sensors: dict[tuple[str, str], tuple[Any, np.random.Generator]] = {}
 
-    def _sensor(self, m: BimanualRubiksMachine, hand: Hand) -> tuple[Any, np.random.Generator]:
+    def _sensor(
+        self, m: BimanualRubiksMachine, hand: Hand, finger: str = "l"
+    ) -> tuple[Any, np.random.Generator]:
+        """The pre-touch sensor (and its random stream) of ``hand``'s ``finger`` ("l" or "r") fingertip;
+        in grid mode the one tool-frame grid whatever ``finger``. Created on first use."""
         from ...sensors import Emitter, PreTouchSensor
 
-        if hand.side not in self._sensors:
-            grid = self.config.pretouch_grid
-            emitters = [Emitter((0.0, y, z), (1.0, 0.0, 0.0)) for y in grid for z in grid]
-            link = hand.arm.config.tcp_link
+        key = (hand.side, finger if self.config.pretouch_mode == "sweep" else "tool")
+        if key not in self._sensors:
+            cfg = self.config
+            body = m.robot.body
+            tcp = hand.arm.config.tcp_link
+            kw: dict[str, Any] = {}
+            if cfg.pretouch_mode == "grid":
+                grid = cfg.pretouch_grid
+                emitters = [Emitter((0.0, y, z), (1.0, 0.0, 0.0)) for y in grid for z in grid]
+                link = tcp
+            else:
+                # one emitter in each fingertip, its window at the pad's front end (the pad runs
+                # to x = 31.25 mm in the fingertip frame), looking along the approach (the fingertip
+                # stays parallel to the palm on the four-bar)
+                link = tcp.replace("gripper_tcp", f"gripper_{finger}_finger_tip_link")
+                emitters = [Emitter((0.032, 0.0, 0.0), (1.0, 0.0, 0.0), "fingertip")]
+                if cfg.pretouch_see_robot:
+                    kw = {"ignore_bodies": (), "ignore_links": ((body, link),)}
             slot = m.ctx.sensors.get("pretouch-tof") if m.ctx.sensors else None
             if slot is not None:
-                sensor = slot.create(backend=m.b, body=m.robot.body, link=link, emitters=emitters)
+                sensor = slot.create(backend=m.b, body=body, link=link, emitters=emitters, **kw)
                 rng = slot.rng
             else:
-                sensor = PreTouchSensor(m.b, m.robot.body, link, emitters)
+                sensor = PreTouchSensor(m.b, body, link, emitters, **kw)
                 rng = np.random.default_rng(m.ctx.rng.integers(2**63))
-            self._sensors[hand.side] = (sensor, rng)
-        return self._sensors[hand.side]
+            self._sensors[key] = (sensor, rng)
+        return self._sensors[key]
 
     def relocalise(self, m: BimanualRubiksMachine, hand: Hand, grip: Pose, label: str) -> Pose:
+        if self.config.pretouch_mode == "grid":
+            return self._relocalise_grid(m, hand, grip, label)
+        return self._relocalise_sweep(m, hand, grip, label)
+
+    def _relocalise_grid(
+        self, m: BimanualRubiksMachine, hand: Hand, grip: Pose, label: str
+    ) -> Pose:
         from ...sensors import CubePoseFilter, PoseEstimate, cube_yaw, yaw_error
 
         cfg = self.config
@@ -291,6 +333,264 @@ class PR2SensorAidedGrasp(PR2Grasp):
             return grip
         # the same finger placement, recomputed from the corrected belief
         local = before.inv() * grip
+        return m.est * local
+
+    @staticmethod
+    def _fk_tip(hand: Hand, sensor: Any) -> Pose:
+        """The fingertip pose the robot's forward kinematics reports (its joint encoders through its
+        kinematic model): the true pose seen through the arm's calibration offset, which the arm's
+        commands carry too (``actual = calibration * commanded``) and the strategy never learns.
+
+        Not the commanded pose: the arm is millimetres and a degree or two from its command while it
+        moves and settles (measured: 2.8 mm and a wrist tilt that read as a 6 degree face tilt).
+        """
+        cal = hand.calibration
+        tcp = hand.arm.tcp_pose()
+        model = Pose.from_rotation(tcp.p - cal.p, cal.rotation.inv() * tcp.rotation)
+        return model * (tcp.inv() * sensor.link_pose())
+
+    #: margin (m) round the other hand's believed finger boxes within which a return counts as the
+    #: robot's own: the two arms' calibrations differ by ~2 mm, and a finger is believed where commanded
+    self_filter_margin: float = 0.004
+
+    def _self_filter(
+        self, m: BimanualRubiksMachine, hand: Hand, o: np.ndarray, d: np.ndarray, z: np.ndarray
+    ) -> np.ndarray:
+        """Which returns may come from the other hand's gripper (a bool per reading).
+
+        A robot knows where its other hand is (its commanded pose and, holding, the cube's width between
+        its pads), so like any self-filter of a point cloud it drops a return whose ray meets that
+        gripper's collision boxes (palm, pads and finger bars, :func:`finger_boxes`, grown by
+        ``self_filter_margin``) no farther than the return. Without it, the giver's pad lying on the face
+        a taker ranges read as a face tilted by 10-15 degrees (measured). Such a return is not fused,
+        and is never part of a face for :func:`~benchharness.sensors.find_edges`, but still counts as
+        beyond an edge when it is far behind the face (the holder's pad end 28 mm behind a side edge).
+        """
+        from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, TCP_X, finger_boxes
+        from ...sensors.raybox import ray_box
+
+        if not self.config.pretouch_see_robot:
+            return np.zeros(len(z), dtype=bool)
+        other = m.other(hand)
+        opening = 2 * CUBE_HALF if other.holding else 2 * (FINGER_TRAVEL + PAD_GAP)
+        boxes = [(np.array([0.08 - TCP_X, 0.0, 0.0]), np.array([0.03, 0.035, 0.025]))]
+        boxes += [
+            (np.array(c) - [TCP_X, 0.0, 0.0], np.array(size) / 2)
+            for c, size in finger_boxes(opening)
+        ]
+        tool = other.cmd
+        rot = tool.rotation.as_matrix()
+        out = np.zeros(len(z), dtype=bool)
+        finite = np.isfinite(z)
+        for c, h in boxes:
+            hits = ray_box(o, d, tool.apply(c), rot, h + self.self_filter_margin)
+            inside = np.all(
+                np.abs((o - tool.apply(c)) @ rot) <= h + self.self_filter_margin, axis=1
+            )
+            own = finite & (inside | (hits.hit & (hits.distance <= z + self.self_filter_margin)))
+            out |= own
+        return out
+
+    def _sweep_plan(
+        self, est: Pose, approach: np.ndarray
+    ) -> list[tuple[str, np.ndarray, np.ndarray]]:
+        """The three sweeps (name, start, end: the emitter window's world position), from the belief.
+
+        The face is the believed box's face towards the hand; ``across`` is its
+        in-face axis nearest horizontal, ``up`` the one nearest world z. The
+        window stays ``sweep.standoff`` off the face: "across" runs at
+        mid-height from ``overshoot`` past one side edge to as far past the
+        other; "up" rises at ``+vertical_offset`` from ``face_depth`` below the
+        top edge to ``overshoot`` above it; "down" comes back at
+        ``-vertical_offset``.
+        """
+        sw = self.config.sweep
+        half = CUBE_HALF
+        rot = est.rotation.as_matrix()
+        k = int(np.argmax(np.abs(rot.T @ approach)))
+        normal = -np.sign(float(rot[:, k] @ approach)) * rot[:, k]  # outward, towards the hand
+        rest = [j for j in range(3) if j != k]
+        j_up = max(rest, key=lambda j: abs(float(rot[2, j])))
+        up = rot[:, j_up] * np.sign(rot[2, j_up])
+        across = np.cross(up, normal)
+        base = est.p + normal * (half + sw.standoff)
+
+        def at(s: float, v: float) -> np.ndarray:
+            return base + s * across + v * up
+
+        far, low = half + sw.overshoot, half - sw.face_depth
+        vo = sw.vertical_offset
+        return [
+            ("across", at(-far, 0.0), at(far, 0.0)),
+            ("up", at(vo, low), at(vo, far)),
+            ("down", at(-vo, far), at(-vo, low)),
+        ]
+
+    def _relocalise_sweep(
+        self, m: BimanualRubiksMachine, hand: Hand, grip: Pose, label: str
+    ) -> Pose:
+        from ...sensors import find_edges
+        from ...sensors.pose6 import POSE6_AXES, CubePose6Filter
+        from ...sensors.pose_estimate import PoseEstimate
+
+        cfg, sw, b = self.config, self.config.sweep, m.b
+        sensors = {f: self._sensor(m, hand, f) for f in ("l", "r")}
+        t0 = b.time
+        pre = hand.cmd  # the pre-grasp, where the hand comes back to
+        q_pre = hand.arm.positions()
+        # each fingertip's window in the tool frame, from the joint encoders (forward kinematics; the
+        # hand is open)
+        tcp_now = hand.arm.tcp_pose()
+        windows = {
+            f: (tcp_now.inv() * s.link_pose()).apply(np.asarray(s.emitters[0].origin, dtype=float))
+            for f, (s, _) in sensors.items()
+        }
+        approach = grip.rotation.apply(along(self.approach_axis, 1.0))
+
+        def tool_at(point: np.ndarray, f: str) -> Pose:
+            return Pose(point - grip.rotation.apply(windows[f]), grip.q)
+
+        dt = float(b.config.timestep)
+        every = max(1, round(1.0 / (sw.rate_hz * dt)))
+        origins, directions, ranges, edges = [], [], [], []
+        done, skipped = [], []
+        for name, start, end in self._sweep_plan(m.est, approach):
+            # the fingertip whose sweep keeps the hand nearer the pre-grasp first, the other if the arm
+            # cannot start it smoothly (a sweep to the far side of the cube can leave the arm's reach)
+            order = sorted(
+                ("l", "r"),
+                key=lambda f: max(
+                    float(np.linalg.norm(tool_at(p, f).p - pre.p)) for p in (start, end)
+                ),
+            )
+            finger = next((f for f in order if m._smooth(hand, tool_at(start, f))), None)
+            if finger is None:
+                skipped.append(name)
+                continue
+            sensor, rng = sensors[finger]
+            a_pose, b_pose = tool_at(start, finger), tool_at(end, finger)
+            try:
+                m.send(hand, a_pose, label=f"{label} pre-touch {name} start", settle=0.05)
+            except StrategyFailure:  # the injected errors put the target just out of reach
+                skipped.append(name)
+                continue
+            if not m._smooth(hand, b_pose):
+                skipped.append(name)
+                continue
+            got: list[Any] = []
+            tick = [0]
+
+            def read(
+                got: list[Any] = got,
+                tick: list[int] = tick,
+                sensor: Any = sensor,
+                rng: np.random.Generator = rng,
+            ) -> None:
+                tick[0] += 1
+                if tick[0] % every:
+                    return
+                got.append(sensor.read(rng, believed_link_pose=self._fk_tip(hand, sensor)))
+
+            handle = b.add_step_callback(read)
+            try:
+                m.send(
+                    hand,
+                    b_pose,
+                    label=f"{label} pre-touch {name}",
+                    duration=float(np.linalg.norm(end - start)) / sw.speed,
+                    settle=0.0,
+                )
+            except StrategyFailure:  # as above: the sweep's end just out of reach; not used
+                got.clear()
+            finally:
+                b.remove_step_callback(handle)
+            if not got:
+                skipped.append(name)
+                continue
+            o = np.concatenate([r.origins for r in got])
+            d = np.concatenate([r.directions for r in got])
+            z = np.concatenate([r.distance for r in got])
+            own = self._self_filter(m, hand, o, d, z)
+            origins.append(o)
+            directions.append(d)
+            ranges.append(np.where(own, np.nan, z))  # the robot's own returns are not fused
+            edges += find_edges(o, d, z, config=sw, tof=sensor.config, exclude=own)
+            done.append(f"{name}({finger})")
+        m.send(hand, pre, label=f"{label} pre-grasp", settle=0.1, seed_q=q_pre)
+        cost = b.time - t0
+
+        pos = cfg.pretouch_prior_pos_std
+        tilt, yaw = (
+            math.radians(cfg.pretouch_prior_tilt_std_deg),
+            math.radians(cfg.pretouch_prior_yaw_std_deg),
+        )
+        std = np.array([pos, pos, pos, tilt, tilt, yaw])
+        before = m.est
+        kf = CubePose6Filter(
+            PoseEstimate(before, np.diag(std**2), n_measurements=1, time=t0, axes=POSE6_AXES),
+            tof=sensors["l"][0].config,
+        )
+        rep = kf.update(
+            np.concatenate(origins) if origins else None,
+            np.concatenate(directions) if directions else None,
+            np.concatenate(ranges) if ranges else None,
+            edges,
+            time=b.time,
+        )
+        if rep.n_rays_used + rep.n_edges_used >= 3:
+            m.est = kf.pose
+            m.reanchor()  # what the holding hand believes it carries
+        # the record (truth read for it only): belief error before and after, along the work axis too
+        true = m.cube.pose()
+
+        def errors(est: Pose) -> tuple[float, list[float], list[float]]:
+            dp = est.p - true.p
+            rv = (est.rotation * true.rotation.inv()).as_rotvec()
+            return (
+                round(1000 * float(dp @ approach), 3),
+                np.round(1000 * dp, 3).tolist(),
+                np.round(np.degrees(rv), 3).tolist(),
+            )
+
+        w0, p0, r0 = errors(before)
+        w1, p1, r1 = errors(m.est)
+        # the same after the sweeps against the truth as this arm's kinematic model sees it (its
+        # calibration offset removed, for the record only): what its grip depends on, and what the
+        # posterior std describes
+        cal = hand.calibration
+        dp_hand = m.est.p - (true.p - cal.p)
+        post_std = np.sqrt(np.diag(kf.P))
+        m.ctx.recorder.event(
+            "pretouch",
+            hand=hand.side,
+            label=label,
+            mode="sweep",
+            move_index=m.move_index,
+            sweeps=done,
+            skipped=skipped,
+            rays=rep.n_rays,
+            used=rep.n_rays_used,
+            edges=rep.n_edges,
+            edges_used=rep.n_edges_used,
+            nis=round(rep.nis, 3),
+            cost_s=round(cost, 4),
+            work_axis=np.round(approach, 3).tolist(),
+            work_err_mm_before=w0,
+            work_err_mm=w1,
+            work_err_hand_mm=round(1000 * float(dp_hand @ approach), 3),
+            err_hand_mm=np.round(1000 * dp_hand, 3).tolist(),
+            err_mm_before=p0,
+            err_mm=p1,
+            rot_err_deg_before=r0,
+            rot_err_deg=r1,
+            std_mm=np.round(1000 * post_std[:3], 3).tolist(),
+            std_deg=np.round(np.degrees(post_std[3:]), 3).tolist(),
+            correction_mm=round(float(1000 * np.linalg.norm(m.est.p - before.p)), 3),
+        )
+        m.ctx.recorder.pose_estimate(m.move_index, true, m.est, label="pretouch")
+        if m.est is before:
+            return grip
+        local = before.inv() * grip  # the same finger placement, from the corrected belief
         return m.est * local
 
 
