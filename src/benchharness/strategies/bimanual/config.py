@@ -52,6 +52,14 @@ class BimanualConfig:
     #: only a hand whose tool frame starts nearer the believed cube centre than this (m) swings round it;
     #: one farther away (an arm out at its side) moves straight to its stand-off. inf: every hand swings.
     swing_radius: float = float("inf")
+    #: the swing's route is checked before the hand moves (:meth:`.machine.BimanualRubiksMachine._swing_route`):
+    #: the direct arc, else a two-leg arc through a via point (over the top, below, diagonally) with the wrist
+    #: rolled at the via, whichever first keeps the arm on its branch (IK chained from the arm's joints, no
+    #: joint stepping more than ``swing_max_joint_step``); none: straight to the stand-off. False: the direct
+    #: arc only, a waypoint out of reach left out.
+    swing_routes: bool = False
+    #: largest joint change (rad) between two waypoints of a checked swing route (bigger: IK flipped the arm).
+    swing_max_joint_step: float = 1.5
     #: how far the taker backs off along its approach (m) before the giver turns the cube in a hand-over:
     #: the turn carries the cube past where the taker's open fingers were.
     taker_retreat: float = 0.15

@@ -110,6 +110,11 @@ class HerbPushGraspConfig(BimanualConfig):
     #: only a hand whose tool frame is nearer the cube than this (m) swings round it; one farther away
     #: (e.g. an arm far out at its side before the pick) moves straight to its stand-off.
     swing_radius: float = 0.30
+    #: check the swing's route before moving, with two-leg arcs through a via point and a wrist roll there
+    #: when the direct arc leaves the arm's branch: HERB's own swing until the move onto the shared machine
+    #: (Rubiks-1-5 on SAPIEN took a two-leg route at the first two hand-over re-grips and succeeded; with the
+    #: direct arc only, waypoints out of reach left out, that trial jammed at twist 9).
+    swing_routes: bool = True
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
     #: the picker and a hand-over's taker grip at the depth they hold next (one slab if they rotate next),
