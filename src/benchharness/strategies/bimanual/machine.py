@@ -722,15 +722,22 @@ class BimanualRubiksMachine:
         relation: str | None = None,
         take: bool = False,
         twist_delta: float | None = None,
+        give_turn: tuple[str, float] | None = None,
     ) -> None:
         """``hand`` grips the cube from ``world_dir``, ``depth`` slabs deep: choose, swing to the stand-off,
         move in and close (the last by the grasp module), then the bookkeeping.
 
         ``k``: the plan action this grip serves; with ``gives`` a two-slab grip is chosen so that the
-        hand can carry its next hand-over turn, if it gives the cube next. ``twist_delta``: the wrist
-        roll of the hand's next twist (default: from the plan after action ``k``).
+        hand can carry its next hand-over turn, if it gives the cube next (not if it grips deeper than
+        ``giver_depth``: it grips again before it gives). ``twist_delta``: the wrist
+        roll of the hand's next twist (default: from the plan after action ``k``). ``give_turn``: the
+        hand-over turn (axis, rad) this grip gives the cube with, whatever its depth (default: the
+        plan's next one after action ``k`` for a two-slab grip with ``gives``).
         """
+        gives = gives and (self.config.giver_depth is None or depth <= self.config.giver_depth)
         turn = self._next_turn(k, hand.side) if (gives and k is not None and depth == 2) else None
+        if give_turn is not None:
+            turn = give_turn
         if twist_delta is None:
             twist_delta = self._next_twist_delta(k, hand.side) if depth == 1 else 0.0
         req = GripRequest(world_dir, depth, label, turn, twist_delta, on_table, relation, take)
@@ -908,10 +915,25 @@ class BimanualRubiksMachine:
     def _handover(self, a: Handover, k: int) -> None:
         giver, taker = self.hands[a.giver], self.hands[a.taker]
         cfg = self.config
+        angle = a.quarter_turns * math.pi / 2
+        if cfg.giver_depth is not None and giver.depth > cfg.giver_depth:
+            # the giver grips again shallower (``giver_depth``) while the taker holds one slab from
+            # its side; the taker then lets go as in every hand-over
+            if not taker.holding:
+                self.grip(taker, SIDE_DIR[taker.side], 1, "hand-over hold", k, twist_delta=0.0)
+            self.release_hand(giver)
+            self.grip(
+                giver,
+                SIDE_DIR[giver.side],
+                cfg.giver_depth,
+                "hand-over give grip",
+                k,
+                twist_delta=0.0,
+                give_turn=(a.axis, angle),
+            )
         self.release_hand(taker, retreat=cfg.taker_retreat)
         centre = self.est.p.copy()
         n = max(1, cfg.handover_waypoints) * abs(a.quarter_turns)
-        angle = a.quarter_turns * math.pi / 2
         start = giver.cmd
         for i in range(1, n + 1):
             self.send(

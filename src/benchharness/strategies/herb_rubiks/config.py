@@ -115,6 +115,12 @@ class HerbPushGraspConfig(BimanualConfig):
     #: (Rubiks-1-5 on SAPIEN took a two-leg route at the first two hand-over re-grips and succeeded; with the
     #: direct arc only, waypoints out of reach left out, that trial jammed at twist 9).
     swing_routes: bool = True
+    #: a two-slab giver grips again one slab deep before the hand-over turn (the taker holding meanwhile):
+    #: the holder's fingers reach 33 mm into the cube, 4.6 mm past its centre, so a parallel take had to slide
+    #: 19.6 mm of its 20 mm limit across its face to clear them, or found no grip (SAPIEN: Rubiks-1-10's first
+    #: take and 3 of Rubiks-5-5's 5 trials `unreachable`; a take slid 20 mm let the held layer slip 47 deg in
+    #: PyBullet's Rubiks-1-5).
+    giver_depth: int | None = 1
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
     #: the picker and a hand-over's taker grip at the depth they hold next (one slab if they rotate next),
