@@ -214,6 +214,38 @@ def _herb_ctx(backend: str, sequence: str, seed: int = 0):
     return ctx, b
 
 
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+def test_short_trial_with_a_hand_over_succeeds_on_both_engines(backend):
+    """Default suite: a whole HERB trial of ``D'`` on the shared bimanual machine (15-30 s per engine).
+
+    Its plan is the machine's every step but a shift: pick from the table, the second grasp, a hand-over
+    (the two-slab giver grips again one slab deep while the taker holds, turns the cube, the taker
+    push-grasps it, the giver re-grips), one physical twist, release. With the default injected errors;
+    the expected state comes from the cube core.
+    """
+    from benchharness.cube import SOLVED, apply, to_string
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    ctx, b = _herb_ctx(backend, "D'")
+    try:
+        out = PushGraspStrategy().run_trial(ctx)
+    finally:
+        b.close()
+    assert out.failure is None, out.message
+    assert out.final_state == to_string(apply(SOLVED, "D'"))
+    events = ctx.recorder.to_json()["events"]
+    moves = [e for e in events if e["kind"] == "move"]
+    assert len(moves) == 1 and moves[0]["as_intended"], moves
+    assert not [e for e in events if e["kind"] == "unintended_rotation"]
+    labels = {e.get("label") for e in events if e["kind"] == "check"}
+    assert {
+        "hand-over hold",
+        "hand-over give grip",
+        "hand-over take",
+        "hand-over re-grip",
+    } <= labels
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "backend",

@@ -450,7 +450,8 @@ class BimanualRubiksMachine:
             raise StrategyFailure(
                 "unreachable",
                 f"{hand.side} arm: no IK solution for {label} "
-                f"(target {np.round(target.p, 3).tolist()})",
+                f"(target {np.round(target.p, 3).tolist()}; the arm ended "
+                f"{1000 * res.pos_error:.1f} mm, {math.degrees(res.rot_error):.1f}° from it)",
             )
         if hand.holding and not self.other(hand).holding and hand.cube_in_tcp is not None:
             self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
