@@ -87,6 +87,10 @@ class BimanualConfig:
     #: check. The PR2 baselines leave it off: their giver's extra IK seeds are drawn from a generator seeded
     #: with the number of events recorded so far, so a new event would change their results.
     reach_warning: float | None = None
+    #: a move whose IK did not converge is carried on with (a warning event) if the arm ended within this
+    #: distance of its target (m), as a move with an injected error would; None: every such move fails the
+    #: trial `unreachable`.
+    ik_slack: float | None = None
     #: the cube counts as dropped if it ends below the table top + 1 cm and this far from the belief (m).
     drop_distance: float = 0.05
     #: stop after this many plan actions (None: the whole plan); the outcome is then the state so far.

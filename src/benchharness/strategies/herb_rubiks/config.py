@@ -121,6 +121,12 @@ class HerbPushGraspConfig(BimanualConfig):
     #: take and 3 of Rubiks-5-5's 5 trials `unreachable`; a take slid 20 mm let the held layer slip 47 deg in
     #: PyBullet's Rubiks-1-5).
     giver_depth: int | None = 1
+    #: a move whose IK did not converge goes on if the arm ended within this of its target (m; the machine's
+    #: ``ik_slack``): at the edge of the WAMs' reach round the twist position a retreat and a hand-over turn
+    #: ended 1.7 mm / 0.4 deg and 4.2 mm / 1.3 deg from targets IK could not meet exactly, and each failed its
+    #: trial (Rubiks-5-5, PyBullet); the injected calibration and tracking errors are as large. The same 5 mm
+    #: as ``reach_warning``.
+    ik_slack: float | None = 0.005
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
     #: the picker and a hand-over's taker grip at the depth they hold next (one slab if they rotate next),
