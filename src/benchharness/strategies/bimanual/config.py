@@ -68,7 +68,7 @@ class BimanualConfig:
     #: that ends at a joint limit leaves no straight way out, and the retreat swings through the cube.
     handover_retreat: float = 0.12
     #: a giver holding more slabs than this grips again at this depth before the hand-over turn, the taker
-    #: holding one slab from its side meanwhile (:meth:`.machine.BimanualRubiksMachine._handover`): a deep
+    #: holding two slabs from its side meanwhile (:meth:`.machine.BimanualRubiksMachine._handover`): a deep
     #: giver's fingers reach across the faces the taker's fingers close on. None: the giver gives as it holds.
     giver_depth: int | None = None
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.

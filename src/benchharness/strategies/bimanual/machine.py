@@ -926,10 +926,13 @@ class BimanualRubiksMachine:
         cfg = self.config
         angle = a.quarter_turns * math.pi / 2
         if cfg.giver_depth is not None and giver.depth > cfg.giver_depth:
-            # the giver grips again shallower (``giver_depth``) while the taker holds one slab from
-            # its side; the taker then lets go as in every hand-over
+            # the giver grips again shallower (``giver_depth``) while the taker holds two slabs from its
+            # side, crossing (a one-slab hold let the cube turn 16 degrees and fall, PyBullet); the taker
+            # then lets go as in every hand-over
+            if taker.holding and taker.depth < 2:
+                self.release_hand(taker)
             if not taker.holding:
-                self.grip(taker, SIDE_DIR[taker.side], 1, "hand-over hold", k, twist_delta=0.0)
+                self.grip(taker, SIDE_DIR[taker.side], 2, "hand-over hold", k, relation="cross")
             self.release_hand(giver)
             self.grip(
                 giver,
