@@ -1,8 +1,10 @@
 """The bimanual Rubik's state machine: every two-armed robot's Rubik's strategy is it, with its own grasp module.
 
-No physics: registration and class contracts. Whole trials of the machine
-driving each robot are in test_pr2_rubiks_sim.py (the PR2, Rubiks-1-5 on
-both engines) and test_herb_push_grasp.py (HERB, a one-move trial).
+No physics: registration and class contracts, the swing's arcs and route
+check. Whole trials of the machine driving each robot are in
+test_pr2_rubiks_sim.py (the PR2, Rubiks-1-5 on both engines) and
+test_herb_push_grasp.py (HERB, a one-move trial with a hand-over on both
+engines; Rubiks-1-5 and longer tiers as slow tests).
 """
 
 from __future__ import annotations

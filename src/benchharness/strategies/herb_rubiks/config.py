@@ -129,11 +129,12 @@ class HerbPushGraspConfig(BimanualConfig):
     ik_slack: float | None = 0.005
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
-    #: the picker and a hand-over's taker grip at the depth they hold next (one slab if they rotate next),
-    #: as HERB's trials were measured with (docs/herb_push_grasp.md): it saves a push-grasp and a release per
-    #: pick and hand-over, and every push shoves the held cube (5.2 mm measured on PyBullet). Whether the
-    #: PR2's two-slab lone grip (True) helps a push-grasp has not been measured.
-    lone_holder_two_slabs: bool = False
+    #: the picker and a hand-over's taker grip two slabs deep whichever hand rotates next (the machine's rule,
+    #: the PR2's too): a one-slab lone grip lost the cube on PyBullet (Rubiks-1-10: the pick's close turned it
+    #: 9 deg and the second grasp's push met no face; Rubiks-5-5: a one-slab hold turned it 16 deg as the other
+    #: hand let go). Measured with it (seed 0): Rubiks-1-5 succeeds on both engines, Rubiks-5-5 PyBullet 3/5
+    #: (was 1/5), SAPIEN 4/5 (as before); it costs a push-grasp and a release per pick and take.
+    lone_holder_two_slabs: bool = True
     #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).
     max_waypoint_jump: float = 2.5
     #: a motion that ends farther than this from its target is logged as a warning event (m).
