@@ -212,5 +212,6 @@ def test_swing_routes_and_giver_depth_are_herb_options_the_pr2_leaves_off():
     from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
     from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
 
-    assert not PR2RubiksConfig().swing_routes and PR2RubiksConfig().giver_depth is None
-    assert HerbPushGraspConfig().swing_routes and HerbPushGraspConfig().giver_depth == 1
+    pr2, herb = PR2RubiksConfig(), HerbPushGraspConfig()
+    assert not pr2.swing_routes and pr2.giver_depth is None and pr2.ik_slack is None
+    assert herb.swing_routes and herb.giver_depth == 1 and herb.ik_slack == 0.005
