@@ -1,8 +1,10 @@
 """The bimanual Rubik's state machine: every two-armed robot's Rubik's strategy is it, with its own grasp module.
 
-No physics: registration and class contracts. Whole trials of the machine
-driving each robot are in test_pr2_rubiks_sim.py (the PR2, Rubiks-1-5 on
-both engines) and test_herb_push_grasp.py (HERB, a one-move trial).
+No physics: registration and class contracts, the swing's arcs and route
+check. Whole trials of the machine driving each robot are in
+test_pr2_rubiks_sim.py (the PR2, Rubiks-1-5 on both engines) and
+test_herb_push_grasp.py (HERB, a one-move trial with a hand-over on both
+engines; Rubiks-1-5 and longer tiers as slow tests).
 """
 
 from __future__ import annotations
@@ -96,3 +98,120 @@ def test_along_builds_the_exact_tool_vector():
     assert along(0, d).tolist() == [d, 0.0, 0.0]
     assert along(2, -d).tolist() == [0.0, 0.0, -d]
     assert np.signbit(along(0, -d)[1]) == np.False_
+
+
+def _herb_machine():
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    return PushGraspStrategy()
+
+
+def test_swing_arc_waypoints_stay_on_the_sphere_and_pass_the_via():
+    """``_arc``: at most ``swing_step_deg`` apart, distance interpolated from r0 to r1, ends left out; a
+    two-leg route passes through its via direction with the via's orientation."""
+    from scipy.spatial.transform import Rotation
+
+    m = _herb_machine()
+    step = m.config.swing_step_deg
+    c = np.array([0.9, 0.0, 1.1])
+    u0, u1, up = np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    q0 = Rotation.identity().as_quat()
+    qv = Rotation.from_euler("x", 90, degrees=True).as_quat()
+    one = m._arc(c, [u0, u1], [q0, q0], 0.15, 0.20)
+    assert len(one) == int(np.ceil(90 / step)) - 1
+    dirs = [u0] + [(w.p - c) / np.linalg.norm(w.p - c) for w in one] + [u1]
+    for a, b in zip(dirs[:-1], dirs[1:]):
+        assert np.degrees(np.arccos(np.clip(np.dot(a, b), -1, 1))) <= step + 1e-9
+    radii = [np.linalg.norm(w.p - c) for w in one]
+    assert all(0.15 < r < 0.20 for r in radii) and radii == sorted(radii)
+    two = m._arc(c, [u0, up, u1], [q0, qv, q0], 0.15, 0.15)
+    at_via = [w for w in two if np.allclose((w.p - c) / 0.15, up, atol=1e-9)]
+    assert len(at_via) == 1 and abs(float(np.dot(at_via[0].q, qv))) == pytest.approx(1.0)
+    assert all(np.linalg.norm(w.p - c) == pytest.approx(0.15) for w in two)
+
+
+class _FakeArm:
+    """IK that succeeds only where ``reachable(position)`` says, without moving a joint."""
+
+    def __init__(self, reachable):
+        self.reachable = reachable
+        self.config = None
+
+    def base_pose(self):
+        from benchharness.geometry import Pose
+
+        return Pose(np.zeros(3))
+
+    def positions(self):
+        return np.zeros(7)
+
+    def ik(self, mats, seed_q=None):
+        from types import SimpleNamespace
+
+        ok = [bool(self.reachable(np.asarray(t)[:3, 3])) for t in mats]
+        return SimpleNamespace(success=ok, q=np.zeros((len(mats), 7)))
+
+
+class _Rec:
+    def __init__(self):
+        self.events = []
+
+    def event(self, kind, **data):
+        self.events.append((kind, data))
+
+
+def _swing_setup(reachable):
+    from types import SimpleNamespace
+
+    from benchharness.geometry import Pose
+    from benchharness.strategies.bimanual.machine import Hand
+
+    m = _herb_machine()
+    c = np.array([0.9, 0.0, 1.1])
+    m.est = Pose(c)
+    m.ctx = SimpleNamespace(recorder=_Rec())
+    arm = _FakeArm(reachable)
+    start, far = Pose(c + [-0.15, 0.0, 0.0]), Pose(c + [0.0, 0.15, 0.0])
+    hand = Hand("left", arm, None, Pose(np.zeros(3)), start)
+    u0, u1 = np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    return m, hand, far, u0, u1, c
+
+
+def test_checked_swing_takes_the_first_route_the_arm_can_follow():
+    """``swing_routes``: the direct arc is refused when a waypoint is out of reach, and a two-leg route
+    over the top is taken whole (recorded as a ``swing`` event); none passes: a warning and no waypoints."""
+    m, hand, far, u0, u1, c = _swing_setup(lambda p: p[2] > c[2] + 0.03 or abs(p[2] - c[2]) < 1e-9)
+    # the ends are level with the cube (reachable), the direct arc's waypoints too: it is taken
+    route = m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15)
+    assert route and all(abs(w.p[2] - c[2]) < 1e-9 for w in route)
+    assert m.ctx.recorder.events[-1] == (
+        "swing",
+        {"hand": "left", "label": "t", "legs": 1, "waypoints": len(route)},
+    )
+    # only above the cube (and the ends) is reachable: the route goes over the top
+    m, hand, far, u0, u1, c = _swing_setup(
+        lambda p: (
+            p[2] > c[2] + 0.03
+            or np.linalg.norm(p - (c + [-0.15, 0, 0])) < 1e-9
+            or np.linalg.norm(p - (c + [0, 0.15, 0])) < 1e-9
+        )
+    )
+    route = m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15)
+    assert route and all(w.p[2] > c[2] + 0.03 for w in route)
+    kind, data = m.ctx.recorder.events[-1]
+    assert kind == "swing" and data["legs"] == 2
+    # nothing between the ends is reachable: no route, a warning
+    m, hand, far, u0, u1, c = _swing_setup(lambda p: False)
+    assert m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15) == []
+    assert m.ctx.recorder.events[-1][0] == "warning"
+
+
+def test_swing_routes_and_giver_depth_are_herb_options_the_pr2_leaves_off():
+    """The PR2's results are pinned bit for bit (test_pr2_rubiks_sim.py): its config keeps the direct arc
+    and gives as it holds; HERB checks its swing routes and gives one slab deep."""
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+
+    pr2, herb = PR2RubiksConfig(), HerbPushGraspConfig()
+    assert not pr2.swing_routes and pr2.giver_depth is None and pr2.ik_slack is None
+    assert herb.swing_routes and herb.giver_depth == 1 and herb.ik_slack == 0.005

@@ -52,6 +52,14 @@ class BimanualConfig:
     #: only a hand whose tool frame starts nearer the believed cube centre than this (m) swings round it;
     #: one farther away (an arm out at its side) moves straight to its stand-off. inf: every hand swings.
     swing_radius: float = float("inf")
+    #: the swing's route is checked before the hand moves (:meth:`.machine.BimanualRubiksMachine._swing_route`):
+    #: the direct arc, else a two-leg arc through a via point (over the top, below, diagonally) with the wrist
+    #: rolled at the via, whichever first keeps the arm on its branch (IK chained from the arm's joints, no
+    #: joint stepping more than ``swing_max_joint_step``); none: straight to the stand-off. False: the direct
+    #: arc only, a waypoint out of reach left out.
+    swing_routes: bool = False
+    #: largest joint change (rad) between two waypoints of a checked swing route (bigger: IK flipped the arm).
+    swing_max_joint_step: float = 1.5
     #: how far the taker backs off along its approach (m) before the giver turns the cube in a hand-over:
     #: the turn carries the cube past where the taker's open fingers were.
     taker_retreat: float = 0.15
@@ -59,6 +67,10 @@ class BimanualConfig:
     #: is checked to end with this retreat (:meth:`.machine.BimanualRubiksMachine._turn_travel`): a turn
     #: that ends at a joint limit leaves no straight way out, and the retreat swings through the cube.
     handover_retreat: float = 0.12
+    #: a giver holding more slabs than this grips again at this depth before the hand-over turn, the taker
+    #: holding two slabs from its side meanwhile (:meth:`.machine.BimanualRubiksMachine._handover`): a deep
+    #: giver's fingers reach across the faces the taker's fingers close on. None: the giver gives as it holds.
+    giver_depth: int | None = None
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.
     handover_waypoints: int = 4
     #: the hand that is about to hold the cube alone (the picker, a hand-over's taker) grips two slabs deep
@@ -75,6 +87,10 @@ class BimanualConfig:
     #: check. The PR2 baselines leave it off: their giver's extra IK seeds are drawn from a generator seeded
     #: with the number of events recorded so far, so a new event would change their results.
     reach_warning: float | None = None
+    #: a move whose IK did not converge is carried on with (a warning event) if the arm ended within this
+    #: distance of its target (m), as a move with an injected error would; None: every such move fails the
+    #: trial `unreachable`.
+    ik_slack: float | None = None
     #: the cube counts as dropped if it ends below the table top + 1 cm and this far from the belief (m).
     drop_distance: float = 0.05
     #: stop after this many plan actions (None: the whole plan); the outcome is then the state so far.

@@ -446,11 +446,20 @@ class BimanualRubiksMachine:
                 message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
                 f"its {label} target (joint error {res.final_joint_error:.3f} rad)",
             )
-        if not res.ik_success:
+        slack = self.config.ik_slack
+        if not res.ik_success and slack is not None and res.pos_error <= slack:
+            self.ctx.recorder.event(
+                "warning",
+                message=f"{hand.side} arm: IK did not converge for {label} (target "
+                f"{np.round(target.p, 3).tolist()}); the arm ended {1000 * res.pos_error:.1f} mm, "
+                f"{math.degrees(res.rot_error):.1f}° from it: carried on",
+            )
+        elif not res.ik_success:
             raise StrategyFailure(
                 "unreachable",
                 f"{hand.side} arm: no IK solution for {label} "
-                f"(target {np.round(target.p, 3).tolist()})",
+                f"(target {np.round(target.p, 3).tolist()}; the arm ended "
+                f"{1000 * res.pos_error:.1f} mm, {math.degrees(res.rot_error):.1f}° from it)",
             )
         if hand.holding and not self.other(hand).holding and hand.cube_in_tcp is not None:
             self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
@@ -532,9 +541,11 @@ class BimanualRubiksMachine:
         waypoint the arm cannot reach is left out. A hand farther than
         ``swing_radius`` from the cube, or whose stand-off is less than
         ``swing_min_deg`` round it, moves straight to the stand-off.
-        """
-        from scipy.spatial.transform import Slerp
 
+        With ``swing_routes`` the route is checked instead (:meth:`_swing_route`): the direct arc
+        or a two-leg arc through a via point, whichever first keeps the arm on its branch all the
+        way; no waypoint is left out.
+        """
         cfg = self.config
         c = self.est.p
         d0, d1 = hand.cmd.p - c, far.p - c
@@ -551,23 +562,122 @@ class BimanualRubiksMachine:
         ):
             self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
             return
-        axis = np.cross(u0, u1)
-        if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
-            axis = np.cross(u0, [0.0, 0.0, 1.0])
-            if np.linalg.norm(axis) < 1e-6:
-                axis = np.array([1.0, 0.0, 0.0])
-        axis = axis / np.linalg.norm(axis)
-        slerp = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([hand.cmd.q, far.q])))
+        if cfg.swing_routes:
+            for way in self._swing_route(hand, far, label, u0, u1, r0, r1):
+                self.send(hand, way, label=f"{label} arc", settle=0.02)
+            self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+            return
         base = hand.arm.base_pose()
-        for i in range(1, n):
-            f = i / n
-            u = Rotation.from_rotvec(axis * angle * f).apply(u0)
-            way = Pose.from_rotation(c + ((1 - f) * r0 + f * r1) * u, slerp([f])[0])
+        for way in self._arc(c, [u0, u1], [hand.cmd.q, far.q], r0, r1):
             if hand.arm.ik(
                 (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
             ).success[0]:
                 self.send(hand, way, label=f"{label} arc", settle=0.02)
         self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+
+    def _arc(self, c: np.ndarray, dirs: list, quats: list, r0: float, r1: float) -> list[Pose]:
+        """Waypoints (tool poses, the ends left out) on great-circle legs about ``c`` through the unit
+        directions ``dirs``, at most ``swing_step_deg`` apart.
+
+        At ``dirs[i]`` the tool has the orientation ``quats[i]`` (x, y, z, w), slerped within a leg; the distance
+        from ``c`` goes linearly from ``r0`` to ``r1`` over the whole route. Two opposite directions
+        are joined over the top.
+        """
+        from scipy.spatial.transform import Slerp
+
+        step = math.radians(self.config.swing_step_deg)
+        legs = []
+        for a, b in zip(dirs[:-1], dirs[1:]):
+            ang = math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0)))
+            axis = np.cross(a, b)
+            if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
+                axis = np.cross(a, [0.0, 0.0, 1.0])
+                if np.linalg.norm(axis) < 1e-6:
+                    axis = np.array([1.0, 0.0, 0.0])
+            legs.append((a, ang, axis / np.linalg.norm(axis)))
+        total = sum(ang for _, ang, _ in legs)
+        out: list[Pose] = []
+        done = 0.0
+        for j, (a, ang, axis) in enumerate(legs):
+            slerp = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([quats[j], quats[j + 1]])))
+            n = max(1, math.ceil(ang / step))
+            last = j == len(legs) - 1
+            for i in range(1, n if last else n + 1):
+                f = i / n
+                # the whole route's fraction (one leg: the leg's own, the same floats as ever)
+                s = f if len(legs) == 1 else (done + ang * f) / total
+                u = Rotation.from_rotvec(axis * ang * f).apply(a)
+                out.append(Pose.from_rotation(c + ((1 - s) * r0 + s * r1) * u, slerp([f])[0]))
+            done += ang
+        return out
+
+    def _swing_route(
+        self,
+        hand: Hand,
+        far: Pose,
+        label: str,
+        u0: np.ndarray,
+        u1: np.ndarray,
+        r0: float,
+        r1: float,
+    ) -> list[Pose]:
+        """The checked swing (``swing_routes``): the first route round the cube the arm can follow.
+
+        Routes, in order: the direct arc; then two-leg arcs through a via direction (the arc's
+        middle, over the top, below, and diagonally between them) with the wrist rolled 0, +-90
+        or 180 deg about the approach at the via (a hand in front of the cube near the torso
+        cannot turn round it directly). A route passes if every waypoint and the stand-off have
+        an IK solution, each seeded with the previous one from the arm's joints, no joint moving
+        more than ``swing_max_joint_step`` between two. None passes: a warning, and the hand moves
+        straight to the stand-off (no waypoints). Recorded as a ``swing`` event.
+        """
+        cfg = self.config
+        c = self.est.p
+        start = hand.cmd
+        up = np.array([0.0, 0.0, 1.0])
+        routes: list[tuple[list, list]] = [([u0, u1], [start.q, far.q])]
+        mid = u0 + u1
+        mid = mid / np.linalg.norm(mid) if np.linalg.norm(mid) > 1e-6 else np.cross(u0, up)
+        vias = [mid]
+        if abs(float(np.dot(u0, up))) < 0.9 and abs(float(np.dot(u1, up))) < 0.9:
+            vias += [up, mid - up, -up, mid + up]
+        for via in vias:
+            via = via / np.linalg.norm(via)
+            axis = np.cross(u0, via)
+            if np.linalg.norm(axis) < 1e-9:
+                axis = np.cross(u0, up) if abs(u0[2]) < 0.9 else np.cross(u0, [1.0, 0.0, 0.0])
+            ang = math.acos(float(np.clip(np.dot(u0, via), -1.0, 1.0)))
+            top = Rotation.from_rotvec(axis / np.linalg.norm(axis) * ang) * start.rotation
+            for roll in (0.0, math.pi / 2, -math.pi / 2, math.pi):
+                rolled = top * Rotation.from_rotvec(along(self.grasp.approach_axis, roll))
+                routes.append(([u0, via, u1], [start.q, rolled.as_quat(), far.q]))
+        base = hand.arm.base_pose()
+        why = ""
+        for dirs, quats in routes:
+            poses = self._arc(c, dirs, quats, r0, r1)
+            q, ok = hand.arm.positions(), True
+            for pose in [*poses, far]:
+                res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q)
+                jump = float(np.max(np.abs(res.q[0] - q)))
+                if not res.success[0] or jump > cfg.swing_max_joint_step:
+                    why += (
+                        f" {len(dirs) - 1}-leg arc: waypoint {np.round(pose.p, 3).tolist()} IK "
+                        f"{bool(res.success[0])}, joint step {jump:.2f} rad;"
+                    )
+                    ok = False
+                    break
+                q = res.q[0]
+            if ok:
+                self.ctx.recorder.event(
+                    "swing", hand=hand.side, label=label, legs=len(dirs) - 1, waypoints=len(poses)
+                )
+                return poses
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: {label}: no arc round the cube on the arm's branch "
+            f"({why.strip()}); one joint-space move to the stand-off",
+        )
+        return []
 
     def release_hand(self, hand: Hand, retreat: float | None = None) -> None:
         """Open (if holding) and stand off ``retreat`` (default ``retreat_distance``) along the approach
@@ -621,15 +731,22 @@ class BimanualRubiksMachine:
         relation: str | None = None,
         take: bool = False,
         twist_delta: float | None = None,
+        give_turn: tuple[str, float] | None = None,
     ) -> None:
         """``hand`` grips the cube from ``world_dir``, ``depth`` slabs deep: choose, swing to the stand-off,
         move in and close (the last by the grasp module), then the bookkeeping.
 
         ``k``: the plan action this grip serves; with ``gives`` a two-slab grip is chosen so that the
-        hand can carry its next hand-over turn, if it gives the cube next. ``twist_delta``: the wrist
-        roll of the hand's next twist (default: from the plan after action ``k``).
+        hand can carry its next hand-over turn, if it gives the cube next (not if it grips deeper than
+        ``giver_depth``: it grips again before it gives). ``twist_delta``: the wrist
+        roll of the hand's next twist (default: from the plan after action ``k``). ``give_turn``: the
+        hand-over turn (axis, rad) this grip gives the cube with, whatever its depth (default: the
+        plan's next one after action ``k`` for a two-slab grip with ``gives``).
         """
+        gives = gives and (self.config.giver_depth is None or depth <= self.config.giver_depth)
         turn = self._next_turn(k, hand.side) if (gives and k is not None and depth == 2) else None
+        if give_turn is not None:
+            turn = give_turn
         if twist_delta is None:
             twist_delta = self._next_twist_delta(k, hand.side) if depth == 1 else 0.0
         req = GripRequest(world_dir, depth, label, turn, twist_delta, on_table, relation, take)
@@ -807,10 +924,28 @@ class BimanualRubiksMachine:
     def _handover(self, a: Handover, k: int) -> None:
         giver, taker = self.hands[a.giver], self.hands[a.taker]
         cfg = self.config
+        angle = a.quarter_turns * math.pi / 2
+        if cfg.giver_depth is not None and giver.depth > cfg.giver_depth:
+            # the giver grips again shallower (``giver_depth``) while the taker holds two slabs from its
+            # side, crossing (a one-slab hold let the cube turn 16 degrees and fall, PyBullet); the taker
+            # then lets go as in every hand-over
+            if taker.holding and taker.depth < 2:
+                self.release_hand(taker)
+            if not taker.holding:
+                self.grip(taker, SIDE_DIR[taker.side], 2, "hand-over hold", k, relation="cross")
+            self.release_hand(giver)
+            self.grip(
+                giver,
+                SIDE_DIR[giver.side],
+                cfg.giver_depth,
+                "hand-over give grip",
+                k,
+                twist_delta=0.0,
+                give_turn=(a.axis, angle),
+            )
         self.release_hand(taker, retreat=cfg.taker_retreat)
         centre = self.est.p.copy()
         n = max(1, cfg.handover_waypoints) * abs(a.quarter_turns)
-        angle = a.quarter_turns * math.pi / 2
         start = giver.cmd
         for i in range(1, n + 1):
             self.send(

@@ -110,13 +110,31 @@ class HerbPushGraspConfig(BimanualConfig):
     #: only a hand whose tool frame is nearer the cube than this (m) swings round it; one farther away
     #: (e.g. an arm far out at its side before the pick) moves straight to its stand-off.
     swing_radius: float = 0.30
+    #: check the swing's route before moving, with two-leg arcs through a via point and a wrist roll there
+    #: when the direct arc leaves the arm's branch: HERB's own swing until the move onto the shared machine
+    #: (Rubiks-1-5 on SAPIEN took a two-leg route at the first two hand-over re-grips and succeeded; with the
+    #: direct arc only, waypoints out of reach left out, that trial jammed at twist 9).
+    swing_routes: bool = True
+    #: a two-slab giver grips again one slab deep before the hand-over turn (the taker holding meanwhile):
+    #: the holder's fingers reach 33 mm into the cube, 4.6 mm past its centre, so a parallel take had to slide
+    #: 19.6 mm of its 20 mm limit across its face to clear them, or found no grip (SAPIEN: Rubiks-1-10's first
+    #: take and 3 of Rubiks-5-5's 5 trials `unreachable`; a take slid 20 mm let the held layer slip 47 deg in
+    #: PyBullet's Rubiks-1-5).
+    giver_depth: int | None = 1
+    #: a move whose IK did not converge goes on if the arm ended within this of its target (m; the machine's
+    #: ``ik_slack``): at the edge of the WAMs' reach round the twist position a retreat and a hand-over turn
+    #: ended 1.7 mm / 0.4 deg and 4.2 mm / 1.3 deg from targets IK could not meet exactly, and each failed its
+    #: trial (Rubiks-5-5, PyBullet); the injected calibration and tracking errors are as large. The same 5 mm
+    #: as ``reach_warning``.
+    ik_slack: float | None = 0.005
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
-    #: the picker and a hand-over's taker grip at the depth they hold next (one slab if they rotate next),
-    #: as HERB's trials were measured with (docs/herb_push_grasp.md): it saves a push-grasp and a release per
-    #: pick and hand-over, and every push shoves the held cube (5.2 mm measured on PyBullet). Whether the
-    #: PR2's two-slab lone grip (True) helps a push-grasp has not been measured.
-    lone_holder_two_slabs: bool = False
+    #: the picker and a hand-over's taker grip two slabs deep whichever hand rotates next (the machine's rule,
+    #: the PR2's too): a one-slab lone grip lost the cube on PyBullet (Rubiks-1-10: the pick's close turned it
+    #: 9 deg and the second grasp's push met no face; Rubiks-5-5: a one-slab hold turned it 16 deg as the other
+    #: hand let go). Measured with it (seed 0): Rubiks-1-5 succeeds on both engines, Rubiks-5-5 PyBullet 3/5
+    #: (was 1/5), SAPIEN 4/5 (as before); it costs a push-grasp and a release per pick and take.
+    lone_holder_two_slabs: bool = True
     #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).
     max_waypoint_jump: float = 2.5
     #: a motion that ends farther than this from its target is logged as a warning event (m).
