@@ -133,6 +133,8 @@ def pad_setback(opening: float) -> float:
     return TCP_X - (tip_x(opening / 2.0) + PAD_CENTRE_X)
 
 
+#: (centre, size) in the palm frame of the palm's collision box (a stand-in for the palm mesh, see _gripper)
+PALM_BOX = ((0.08, 0.0, 0.0), (0.06, 0.07, 0.05))
 BAR_X0 = FINGER_X + 0.02  # m: the finger bar's palm end (a stand-in for the proximal link's shape)
 BAR_SIZE_YZ = (0.008, 0.02)  # m
 
@@ -432,7 +434,7 @@ def _gripper(m: UrdfBuilder, s: str) -> None:
     )
     m.link(
         f"{s}_gripper_palm_link",
-        [Geom("box", (0.06, 0.07, 0.05), (0.08, 0.0, 0.0))],
+        [Geom("box", PALM_BOX[1], PALM_BOX[0])],
         0.58007,
         com=(0.06623, 0.00053, -0.00119),
         inertia=(

@@ -549,7 +549,7 @@ class BimanualRubiksMachine:
             or r0 > cfg.swing_radius
             or math.degrees(angle) < cfg.swing_min_deg
         ):
-            self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+            self.transit(hand, far, label=label, seed_q=seed_q)
             return
         axis = np.cross(u0, u1)
         if np.linalg.norm(axis) < 1e-6:  # opposite sides: go over the top
@@ -567,7 +567,88 @@ class BimanualRubiksMachine:
                 (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
             ).success[0]:
                 self.send(hand, way, label=f"{label} arc", settle=0.02)
-        self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+        self.transit(hand, far, label=label, seed_q=seed_q)
+
+    def _ik_q(self, hand: Hand, pose: Pose, seed: np.ndarray) -> np.ndarray | None:
+        """The arm's IK solution for the (believed) tool pose ``pose`` from ``seed``; None if unreachable."""
+        base = hand.arm.base_pose()
+        res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
+        return np.asarray(res.q[0], dtype=float) if bool(res.success[0]) else None
+
+    def sweep_clearance(
+        self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int = 16
+    ) -> float:
+        """Least distance (m) from the believed cube (a box) of the hand's ``points`` (tool frame) along
+        the straight joint path ``q0`` -> ``q1`` (the path :meth:`RobotArm.move_to_joints` tracks)."""
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        t = np.asarray(hand.arm.fk(q0 + s * (q1 - q0)), dtype=float)
+        w = hand.arm.base_pose().as_matrix() @ t
+        p = np.einsum("nij,pj->npi", w[:, :3, :3], points) + w[:, None, :3, 3]
+        local = self.est.rotation.inv().apply(p.reshape(-1, 3) - self.est.p)
+        return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - CUBE_HALF, 0.0), axis=1)))
+
+    def transit(
+        self, hand: Hand, target: Pose, *, label: str, seed_q: np.ndarray | None = None
+    ) -> None:
+        """Move a free hand to the stand-off ``target`` without sweeping it through the cube.
+
+        The move is one joint-space motion to the IK solution nearest ``seed_q``
+        (the grip's planned branch). If that straight joint path brings the
+        hand (the grasp module's ``hand_points``, open) nearer the believed
+        cube than ``sweep_clearance``, the hand instead backs straight out along
+        its approach to the first of ``detour_distances`` from which the
+        swing to the stand-off's orientation (and the straight move back in)
+        stays clear, and a ``detour`` event is recorded. If none does, the
+        direct move is made and a warning recorded.
+        """
+        cfg = self.config
+        points_of = getattr(self.grasp, "hand_points", None)
+        points = points_of() if points_of is not None else None
+        if points is None or cfg.sweep_clearance <= 0:
+            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            return
+        q0 = hand.arm.positions()
+        plan_seed = q0 if seed_q is None else seed_q
+        q1 = self._ik_q(hand, target, plan_seed)
+        clear = self.sweep_clearance(hand, q0, q1, points) if q1 is not None else np.inf
+        if clear >= cfg.sweep_clearance:
+            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            return
+        c = self.est.p
+        r0 = float(np.linalg.norm(hand.cmd.p - c))
+        r1 = float(np.linalg.norm(target.p - c))
+        for d in cfg.detour_distances:
+            out = self.back_off(hand.cmd, max(0.0, d - r0))
+            turned = self.back_off(target, max(0.0, d - r1))
+            qa = self._ik_q(hand, out, q0)
+            qb = self._ik_q(hand, turned, plan_seed) if qa is not None else None
+            qc = self._ik_q(hand, target, qb) if qb is not None else None
+            if qa is None or qb is None or qc is None:
+                continue
+            legs = min(
+                self.sweep_clearance(hand, q0, qa, points),
+                self.sweep_clearance(hand, qa, qb, points),
+                self.sweep_clearance(hand, qb, qc, points),
+            )
+            if legs < cfg.sweep_clearance:
+                continue
+            self.ctx.recorder.event(
+                "detour",
+                hand=hand.side,
+                label=label,
+                clearance_mm=round(1000 * clear, 1),
+                distance_m=d,
+            )
+            self.send(hand, out, label=f"{label} detour out", settle=0.02)
+            self.send(hand, turned, label=f"{label} detour turn", settle=0.02, seed_q=qb)
+            self.send(hand, target, label=label, settle=0.05, seed_q=qc)
+            return
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: the move to the {label} passes {1000 * clear:.0f} mm from the "
+            f"cube and no detour clears it",
+        )
+        self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
 
     def release_hand(self, hand: Hand, retreat: float | None = None) -> None:
         """Open (if holding) and stand off ``retreat`` (default ``retreat_distance``) along the approach
