@@ -83,6 +83,8 @@ def _soft(key: str, lower: float, upper: float) -> dict[str, float]:
 #: circle of radius FINGER_RADIUS about the pivot. We model exactly that pad motion with two prismatic
 #: joints per finger (see :func:`_gripper`).
 GRIPPER_MAX_OPENING = 0.09  # m; l_gripper_joint upper="0.09" (gripper_v0/gripper.urdf.xacro)
+#: m/s per finger: l_gripper_joint (the gap between the fingers) velocity="0.2" (gripper_v0/gripper.urdf.xacro)
+GRIPPER_CLOSE_SPEED = 0.2 / 2
 PAD_GAP = 0.001  # m; each pad's inner face sits this far out from the finger joint value (pads never interpenetrate)
 FINGER_TRAVEL = (GRIPPER_MAX_OPENING - 2 * PAD_GAP) / 2  # per finger
 TCP_X = 0.18  # m; l_gripper_tool_frame origin xyz="0.18 0 0" (pr2_description gripper_v0/gripper.urdf.xacro)
