@@ -138,6 +138,9 @@ def test_cube_held_by_one_gripper_turns_less_than_2_degrees(
     assert not rotator.gripper.touching(st.cube.body)
     assert len(trace) > 500  # approach, close, twist, open and retreat were all traced
     worst_t, worst = max(trace, key=lambda r: r[1])
+    print(
+        f"{backend}/{finger_preference}/{error}: worst turn {worst:.2f} deg at t = {worst_t:.2f} s"
+    )
     assert worst < LIMIT_DEG, (
         f"{backend}/{finger_preference}/{error}: the cube held by the {holder} gripper turned {worst:.2f} deg "
         f"in its grip (t = {worst_t:.2f} s)"

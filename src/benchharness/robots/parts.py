@@ -648,13 +648,17 @@ class Gripper:
         )
 
     def _touching_links(self, obj: BodyId | None) -> set[str]:
-        """The hand's finger links that touch ``obj`` (or anything but the robot) now."""
+        """The hand's finger links that press on ``obj`` (or anything but the robot) now.
+
+        Pressing, not merely listed: PhysX reports contact points from ``contact_offset`` (2 mm) away,
+        and a finger stopped there with a 1.5 mm spring (3 N) never touched (measured, SAPIEN).
+        """
         r = self.robot
         links = set(self.config.finger_links)
         return {
             c.link_a
             for c in r.backend.contacts(r.body, obj)
-            if c.link_a in links and c.body_b != r.body
+            if c.link_a in links and c.body_b != r.body and c.normal_force > 0.0
         }
 
     def _squeeze(self, obj: BodyId | None, force_limit, first: GraspResult) -> GraspResult:
