@@ -419,7 +419,9 @@ class Gripper:
     def _send(self, q: np.ndarray) -> None:
         """Send the joints' PD targets ``q`` with their force caps, plus gravity feed-forward if the hand
         has it (:attr:`GripperConfig.gravity_compensated`): the target moves by ``tau / k`` and the cap
-        by ``|tau|``, so the drive presses with ``force_limit`` on top of carrying its finger."""
+        by ``|tau|``. Exact while a drive is unsaturated (the tracked close and the squeeze keep it so:
+        it then presses with its spring force on top of carrying its finger); the engines' caps are
+        symmetric, so a saturated drive (a step target, ``open()``) pushes up to ``|tau|`` harder."""
         k = np.asarray(self.config.stiffness, dtype=float)
         force = self._force
         if self.config.gravity_compensated:
@@ -642,7 +644,7 @@ class Gripper:
         self._targets = tgt.copy()
         self._send(tgt)
         self._aim_linkages()
-        res = self._wait(obj, max(0.1, 0.3), u)
+        res = self._wait(obj, 0.3, u)  # the spring presses; rest
         return GraspResult(
             res.contact, res.closed, res.actuators, res.joint_positions, t + res.time
         )

@@ -122,6 +122,10 @@ class GraspModule(Protocol):
     axes (0 = x, 1 = y, 2 = z) along which the hand approaches the face it
     grips and across which its fingers close; the wrist's last joint rolls
     about the approach axis.
+
+    Optional: ``hand_points() -> np.ndarray`` (N x 3, tool frame, m), points filling the open
+    hand; with it the machine keeps a free hand's moves to its stand-offs from sweeping through
+    the cube (:meth:`BimanualRubiksMachine.transit`). A module without it is not checked.
     """
 
     approach_axis: int
