@@ -76,18 +76,19 @@ def _run_cli(tmp_path, strategy: str, backend: str, task: str = "Rubiks-1-5"):
 #: event time and pose estimate). Speed-ups must not move a bit of a result; a change that moves results on
 #: purpose re-records these and says why. Re-recorded for issue 16 item 2 (one-hand holds): the PR2 gripper
 #: now closes at the published gap speed with each finger stopping where it touches, and its finger drives
-#: carry their own weight, so every close ends sooner (first recorded at commit 7b3b4b1: PyBullet 98.07 /
+#: carry their own weight, so every close ends sooner; a free hand's retreat is checked not to sweep
+#: the held cube (first recorded at commit 7b3b4b1: PyBullet 98.07 /
 #: 103.12 s, SAPIEN 93.37 / 98.43 s).
 REFERENCE_ROWS = {
     "pybullet": (
-        87.33333333333334,
-        92.54166666666667,
-        "467aa74bd0ebda90",
+        87.55833333333334,
+        92.76666666666667,
+        "cd042aa9c0f9d070",
     ),
     "sapien": (
-        84.77083333333333,
-        89.95416666666667,
-        "643e63cf735d0cd7",
+        85.25,
+        90.43333333333334,
+        "dd8c358c67f6cc72",
     ),
 }
 

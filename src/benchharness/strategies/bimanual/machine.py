@@ -591,6 +591,37 @@ class BimanualRubiksMachine:
         local = self.est.rotation.inv().apply(p.reshape(-1, 3) - self.est.p)
         return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - CUBE_HALF, 0.0), axis=1)))
 
+    def _hand_points(self) -> np.ndarray | None:
+        """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
+        points_of = getattr(self.grasp, "hand_points", None)
+        if points_of is None or self.config.sweep_clearance <= 0:
+            return None
+        return np.asarray(points_of(), dtype=float)
+
+    def _clears(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray) -> bool:
+        """Whether the straight joint path ``q0`` -> ``q1`` keeps the hand clear of the believed cube:
+        never nearer than ``sweep_clearance``, or than it starts if it starts nearer (a hand backing
+        out from round the cube) less 1 mm."""
+        start = self.sweep_clearance(hand, q0, q0, points, n=1)
+        need = min(start, self.config.sweep_clearance) - 1e-3
+        return self.sweep_clearance(hand, q0, q1, points) >= need
+
+    def _line(
+        self, hand: Hand, a: Pose, b: Pose, q: np.ndarray, points: np.ndarray, step: float = 0.02
+    ) -> list[tuple[Pose, np.ndarray]] | None:
+        """Waypoints (pose, IK solution) at most ``step`` apart on the straight line from ``a`` to ``b``
+        (same orientation), each solved from the last and each joint path clear; None if not."""
+        n = max(1, math.ceil(float(np.linalg.norm(b.p - a.p)) / step))
+        out = []
+        for i in range(1, n + 1):
+            way = Pose(a.p + (b.p - a.p) * i / n, b.q)
+            q1 = self._ik_q(hand, way, q)
+            if q1 is None or not self._clears(hand, q, q1, points):
+                return None
+            out.append((way, q1))
+            q = q1
+        return out
+
     def transit(
         self, hand: Hand, target: Pose, *, label: str, seed_q: np.ndarray | None = None
     ) -> None:
@@ -599,42 +630,40 @@ class BimanualRubiksMachine:
         The move is one joint-space motion to the IK solution nearest ``seed_q``
         (the grip's planned branch). If that straight joint path brings the
         hand (the grasp module's ``hand_points``, open) nearer the believed
-        cube than ``sweep_clearance``, the hand instead backs straight out along
-        its approach to the first of ``detour_distances`` from which the
-        swing to the stand-off's orientation (and the straight move back in)
-        stays clear, and a ``detour`` event is recorded. If none does, the
-        direct move is made and a warning recorded.
+        cube than ``sweep_clearance`` (or than it starts, if it starts nearer),
+        the hand instead backs straight out along its approach in 2 cm steps to
+        the first of ``detour_distances`` from which the swing to the stand-off's
+        orientation and the straight way back in (in 2 cm steps) stay clear, and
+        a ``detour`` event is recorded. If none does, the direct move is made and
+        a warning recorded.
         """
         cfg = self.config
-        points_of = getattr(self.grasp, "hand_points", None)
-        points = points_of() if points_of is not None else None
-        if points is None or cfg.sweep_clearance <= 0:
+        points = self._hand_points()
+        if points is None:
             self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
             return
         q0 = hand.arm.positions()
         plan_seed = q0 if seed_q is None else seed_q
         q1 = self._ik_q(hand, target, plan_seed)
-        clear = self.sweep_clearance(hand, q0, q1, points) if q1 is not None else np.inf
-        if clear >= cfg.sweep_clearance:
+        if q1 is None or self._clears(hand, q0, q1, points):
             self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
             return
+        clear = self.sweep_clearance(hand, q0, q1, points)
         c = self.est.p
         r0 = float(np.linalg.norm(hand.cmd.p - c))
         r1 = float(np.linalg.norm(target.p - c))
         for d in cfg.detour_distances:
             out = self.back_off(hand.cmd, max(0.0, d - r0))
             turned = self.back_off(target, max(0.0, d - r1))
-            qa = self._ik_q(hand, out, q0)
-            qb = self._ik_q(hand, turned, plan_seed) if qa is not None else None
-            qc = self._ik_q(hand, target, qb) if qb is not None else None
-            if qa is None or qb is None or qc is None:
+            leg_out = self._line(hand, hand.cmd, out, q0, points)
+            if leg_out is None:
                 continue
-            legs = min(
-                self.sweep_clearance(hand, q0, qa, points),
-                self.sweep_clearance(hand, qa, qb, points),
-                self.sweep_clearance(hand, qb, qc, points),
-            )
-            if legs < cfg.sweep_clearance:
+            qa = leg_out[-1][1]
+            qb = self._ik_q(hand, turned, plan_seed)
+            if qb is None or not self._clears(hand, qa, qb, points):
+                continue
+            leg_in = self._line(hand, turned, target, qb, points)
+            if leg_in is None:
                 continue
             self.ctx.recorder.event(
                 "detour",
@@ -643,9 +672,18 @@ class BimanualRubiksMachine:
                 clearance_mm=round(1000 * clear, 1),
                 distance_m=d,
             )
-            self.send(hand, out, label=f"{label} detour out", settle=0.02)
+            for way, q in leg_out:
+                self.send(hand, way, label=f"{label} detour out", settle=0.02, seed_q=q)
             self.send(hand, turned, label=f"{label} detour turn", settle=0.02, seed_q=qb)
-            self.send(hand, target, label=label, settle=0.05, seed_q=qc)
+            for k, (way, q) in enumerate(leg_in):
+                last = k == len(leg_in) - 1
+                self.send(
+                    hand,
+                    way,
+                    label=label if last else f"{label} detour in",
+                    settle=0.05 if last else 0.02,
+                    seed_q=q,
+                )
             return
         self.ctx.recorder.event(
             "warning",
@@ -661,8 +699,10 @@ class BimanualRubiksMachine:
         The open hand is still round the cube, so the retreat must be a
         straight move: if the stand-off's IK solution is more than
         ``max_waypoint_jump`` from the arm's joints (a joint limit on the way
-        out, another branch beyond), it backs off in 2 cm steps only as far
-        as the arm follows smoothly and logs a warning.
+        out, another branch beyond), or its joint path would bring the hand
+        nearer the cube (with the grasp module's ``hand_points``: see
+        :meth:`transit`), it backs off in 2 cm steps only as far as the arm
+        follows smoothly and clear, and logs a warning.
         """
         if hand.holding:
             self.grasp.open(self, hand)
@@ -675,17 +715,31 @@ class BimanualRubiksMachine:
             or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)
         ):
             return
-        if self._smooth(hand, back):
-            self.send(hand, back, label="retreat", settle=0.05)
+        points = self._hand_points()
+
+        def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
+            """Smooth, and (with hand points) clear of the cube; the IK solution to seed the move with."""
+            if not self._smooth(hand, target):
+                return False, None
+            if points is None:
+                return True, None
+            q0 = hand.arm.positions()
+            q1 = self._ik_q(hand, target, q0)
+            return (q1 is not None and self._clears(hand, q0, q1, points)), q1
+
+        ok, q_back = way_out(back)
+        if ok:
+            self.send(hand, back, label="retreat", settle=0.05, seed_q=q_back)
             return
         step = 0.02
         approach = ref.rotation.apply(along(self.grasp.approach_axis, 1.0))
         dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
         while dist + step <= d + 1e-9:
             nxt = self.back_off(ref, dist + step)
-            if not self._smooth(hand, nxt):
+            ok, q_next = way_out(nxt)
+            if not ok:
                 break
-            self.send(hand, nxt, label="retreat step", settle=0.02)
+            self.send(hand, nxt, label="retreat step", settle=0.02, seed_q=q_next)
             dist += step
         self.ctx.recorder.event(
             "warning",
