@@ -133,8 +133,10 @@ class GripperConfig:
     #: fingers) has their weights cancel in the transmission; independent finger drives standing in for it
     #: would otherwise press one pad harder than the other by twice a finger's weight whenever the
     #: fingers close vertically (PR2: 2 x 2.1 N), a net push on what they hold (docs/strategies.md,
-    #: "One-hand holds"). Needs a backend with ``capabilities.gravity_torques``; False: the drive's
-    #: force cap is all it has (hands whose motors carry their own fingers).
+    #: "One-hand holds"). Applied to ``close()`` and its squeeze, whose targets are unsaturated springs
+    #: (``set_command(..., feed_forward=True)`` elsewhere): the engines' force caps are symmetric, so a
+    #: saturated drive cannot be compensated. Needs a backend with ``capabilities.gravity_torques``;
+    #: False: the drive's force cap is all it has (hands whose motors carry their own fingers).
     gravity_compensated: bool = False
     #: joint speed (m/s or rad/s) at which ``close()`` moves each joint's target towards closed, stopping
     #: each finger where its link first touches (then pressing with ``force_limit`` as a spring): the

@@ -387,6 +387,7 @@ class Gripper:
         self._link_plan: tuple | None = None  # see _aim_linkages
         self._aimed_at: float | None = None  # sim time of the last re-aim while moving (see update)
         self._sent_gravity: np.ndarray | None = None  # feed-forward last sent (gravity_compensated)
+        self._ff = False  # the targets in force carry gravity feed-forward (see set_command)
 
     @property
     def name(self) -> str:
@@ -397,9 +398,19 @@ class Gripper:
         return self.config.joints
 
     def set_command(
-        self, u: Sequence[float], force_limit: float | Sequence[float] | None = None
+        self,
+        u: Sequence[float],
+        force_limit: float | Sequence[float] | None = None,
+        *,
+        feed_forward: bool = False,
     ) -> None:
-        """Drive the joints towards the coupled targets of actuator values ``u``."""
+        """Drive the joints towards the coupled targets of actuator values ``u``.
+
+        ``feed_forward``: add gravity feed-forward (only a ``gravity_compensated`` hand; see
+        :meth:`_send`) — for unsaturated spring targets such as :meth:`close`'s squeeze. Off, the
+        drives get the plain targets and caps (a saturated drive pushes with its cap).
+        """
+        self._ff = feed_forward and self.config.gravity_compensated
         self.command = np.asarray(u, dtype=float)
         q = np.clip(self.config.joint_targets(self.command), self.lower, self.upper)
         f = self.config.force_limit if force_limit is None else force_limit
@@ -417,14 +428,15 @@ class Gripper:
         self._aim_linkages()
 
     def _send(self, q: np.ndarray) -> None:
-        """Send the joints' PD targets ``q`` with their force caps, plus gravity feed-forward if the hand
-        has it (:attr:`GripperConfig.gravity_compensated`): the target moves by ``tau / k`` and the cap
+        """Send the joints' PD targets ``q`` with their force caps, plus gravity feed-forward if the
+        targets in force take it (:meth:`set_command`'s ``feed_forward``, :meth:`close` of a
+        ``gravity_compensated`` hand): the target moves by ``tau / k`` and the cap
         by ``|tau|``. Exact while a drive is unsaturated (the tracked close and the squeeze keep it so:
         it then presses with its spring force on top of carrying its finger); the engines' caps are
         symmetric, so a saturated drive (a step target, ``open()``) pushes up to ``|tau|`` harder."""
         k = np.asarray(self.config.stiffness, dtype=float)
         force = self._force
-        if self.config.gravity_compensated:
+        if self._ff:
             tau = self._finger_gravity()
             self._sent_gravity = tau
             q = q + tau / np.maximum(k, 1e-9)
@@ -448,7 +460,7 @@ class Gripper:
 
     def _refresh_gravity(self) -> None:
         """Re-send the targets when the fingers' gravity load moved (> 0.01 N): the wrist turned."""
-        if not self.config.gravity_compensated or self.config.follow:
+        if not self._ff or self.config.follow:
             return
         tau = self._finger_gravity()
         if self._sent_gravity is None or np.max(np.abs(tau - self._sent_gravity)) > 0.01:
@@ -615,6 +627,9 @@ class Gripper:
         sign = np.sign(q_goal - q)  # the closing direction of each joint
         stopped = np.zeros(len(names), dtype=bool)
         self.command = np.asarray(u, dtype=float)
+        self._ff = (
+            cfg.gravity_compensated
+        )  # the targets below stay unsaturated: feed-forward is exact
         self._force = 1.5 * f  # an unsaturated spring presses with f at the f / k offset below
         t, rest = 0.0, 0.0
         while t < timeout:
@@ -679,7 +694,7 @@ class Gripper:
         k = np.asarray(self.config.stiffness, dtype=float)
         q = first.joint_positions
         u = np.array([float(np.mean(q)) - float(np.mean(f / k))])
-        self.set_command(u, 1.5 * f)
+        self.set_command(u, 1.5 * f, feed_forward=True)
         res = self._wait(obj, 0.5, u)
         return GraspResult(
             res.contact, False, res.actuators, res.joint_positions, first.time + res.time
