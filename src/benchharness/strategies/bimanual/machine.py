@@ -600,10 +600,12 @@ class BimanualRubiksMachine:
 
     def _clears(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray) -> bool:
         """Whether the straight joint path ``q0`` -> ``q1`` keeps the hand clear of the believed cube:
-        never nearer than ``sweep_clearance``, or than it starts if it starts nearer (a hand backing
-        out from round the cube) less 1 mm."""
+        never nearer than ``sweep_clearance`` or, for a hand that starts nearer (backing out from round
+        the cube: open pads 16 mm from its faces), than it starts less 5 mm (at most half of it). A
+        joint-space step of a few centimetres strays a few millimetres from its straight Cartesian line
+        (measured: 2-3 mm for 2 cm steps of a PR2 giver's retreat); a sweep through the cube reaches 0."""
         start = self.sweep_clearance(hand, q0, q0, points, n=1)
-        need = min(start, self.config.sweep_clearance) - 1e-3
+        need = min(start - min(5e-3, 0.5 * start), self.config.sweep_clearance)
         return self.sweep_clearance(hand, q0, q1, points) >= need
 
     def _line(
