@@ -54,3 +54,44 @@ def test_stage_puts_the_tool_where_commanded(backend):
             assert (got.rotation * target.rotation.inv()).magnitude() < 1e-5
     finally:
         b.close()
+
+
+@pytest.mark.parametrize("force", [3.0, 20.0])
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+def test_vertical_fingers_press_equally_on_what_they_hold(backend, force):
+    """Fingers closing vertically on a fixed block press it with the force asked for, both alike.
+
+    The real gripper's fingers share one motor through the mimic linkage, so their weights (2.1 N each)
+    cancel; the model's independent finger drives carry their own weight (``gravity_compensated``) and
+    close together at the published gap speed (``close_speed``). Without that, the upper pad pressed
+    twice a finger's weight harder than the lower one: a net push on a cube held by the other hand.
+    """
+    from benchharness.backends.interface import Box
+    from benchharness.robots.descriptions.pr2 import pad_setback
+
+    m = get_manager()
+    b = m.create("backend", backend, config=PhysicsConfig())
+    try:
+        robot = m.create("robot", "pr2-gripper")
+        robot.spawn(b)
+        arm, grip = robot.arm("stage"), robot.gripper("gripper")
+        # approach along world x, the fingers closing along world z
+        tool = Pose.from_rotation([0.0, 0.0, 0.4], Rotation.from_euler("x", 90, degrees=True))
+        arm.move_to_joints(stage_joints_for(tool), settle=0.3)
+        grip.open(wait=0.5)
+        centre = arm.tcp_pose().p - [pad_setback(0.057), 0.0, 0.0]
+        block = b.add_body(
+            [Box((0.01, 0.02, 0.0285))], Pose(np.asarray(centre)), 0.1, fixed=True, name="block"
+        )
+        res = grip.close(force_limit=force, obj=block)
+        assert res.contact and not res.closed
+        robot.settle(0.3)
+        pads: dict[str, float] = {}
+        for c in b.contacts(robot.body, block):
+            pads[c.link_a] = pads.get(c.link_a, 0.0) + c.normal_force
+        assert set(pads) == set(grip.config.finger_links), pads
+        f = np.array(list(pads.values()))
+        assert np.all(np.abs(f - force) < 0.1 * force + 0.3), pads
+        assert abs(f[0] - f[1]) < 0.1 * force + 0.3, pads
+    finally:
+        b.close()

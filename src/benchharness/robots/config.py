@@ -127,6 +127,22 @@ class GripperConfig:
     #: fingertip joints that follow their finger's lateral joint on a linkage's arc (not in ``joints``:
     #: the actuators, forces and openings stay those of ``joints``)
     linkages: tuple[FingertipLinkage, ...] = ()
+    #: each joint's drive also carries the weight its links put on it (gravity feed-forward, refreshed
+    #: every control tick), so that ``force_limit`` is the force the finger presses with in any
+    #: orientation. Why: a hand whose fingers one transmission couples (the PR2's: one motor, mimic
+    #: fingers) has their weights cancel in the transmission; independent finger drives standing in for it
+    #: would otherwise press one pad harder than the other by twice a finger's weight whenever the
+    #: fingers close vertically (PR2: 2 x 2.1 N), a net push on what they hold (docs/strategies.md,
+    #: "One-hand holds"). Applied to ``close()`` and its squeeze, whose targets are unsaturated springs
+    #: (``set_command(..., feed_forward=True)`` elsewhere): the engines' force caps are symmetric, so a
+    #: saturated drive cannot be compensated. Needs a backend with ``capabilities.gravity_torques``;
+    #: False: the drive's force cap is all it has (hands whose motors carry their own fingers).
+    gravity_compensated: bool = False
+    #: joint speed (m/s or rad/s) at which ``close()`` moves each joint's target towards closed, stopping
+    #: each finger where its link first touches (then pressing with ``force_limit`` as a spring): the
+    #: fingers close together at a bounded speed, as a position-controlled gripper's do. Needs one
+    #: finger link per joint. None: a step target, the force cap alone limiting the motion.
+    close_speed: float | None = None
 
     def joint_targets(self, u: Sequence[float]) -> np.ndarray:
         return np.asarray(self.coupling, dtype=float) @ np.asarray(u, dtype=float)

@@ -386,6 +386,8 @@ class Gripper:
         )
         self._link_plan: tuple | None = None  # see _aim_linkages
         self._aimed_at: float | None = None  # sim time of the last re-aim while moving (see update)
+        self._sent_gravity: np.ndarray | None = None  # feed-forward last sent (gravity_compensated)
+        self._ff = False  # the targets in force carry gravity feed-forward (see set_command)
 
     @property
     def name(self) -> str:
@@ -396,9 +398,19 @@ class Gripper:
         return self.config.joints
 
     def set_command(
-        self, u: Sequence[float], force_limit: float | Sequence[float] | None = None
+        self,
+        u: Sequence[float],
+        force_limit: float | Sequence[float] | None = None,
+        *,
+        feed_forward: bool = False,
     ) -> None:
-        """Drive the joints towards the coupled targets of actuator values ``u``."""
+        """Drive the joints towards the coupled targets of actuator values ``u``.
+
+        ``feed_forward``: add gravity feed-forward (only a ``gravity_compensated`` hand; see
+        :meth:`_send`) — for unsaturated spring targets such as :meth:`close`'s squeeze. Off, the
+        drives get the plain targets and caps (a saturated drive pushes with its cap).
+        """
+        self._ff = feed_forward and self.config.gravity_compensated
         self.command = np.asarray(u, dtype=float)
         q = np.clip(self.config.joint_targets(self.command), self.lower, self.upper)
         f = self.config.force_limit if force_limit is None else force_limit
@@ -410,6 +422,25 @@ class Gripper:
                 i, k = self.joints.index(fj), self.joints.index(lj)
                 q = q.copy()
                 q[i] = np.clip(ratio * pos[k], self.lower[i], self.upper[i])
+        self._sent_gravity = None
+        self._send(q)
+        self._link_sent = None
+        self._aim_linkages()
+
+    def _send(self, q: np.ndarray) -> None:
+        """Send the joints' PD targets ``q`` with their force caps, plus gravity feed-forward if the
+        targets in force take it (:meth:`set_command`'s ``feed_forward``, :meth:`close` of a
+        ``gravity_compensated`` hand): the target moves by ``tau / k`` and the cap
+        by ``|tau|``. Exact while a drive is unsaturated (the tracked close and the squeeze keep it so:
+        it then presses with its spring force on top of carrying its finger); the engines' caps are
+        symmetric, so a saturated drive (a step target, ``open()``) pushes up to ``|tau|`` harder."""
+        k = np.asarray(self.config.stiffness, dtype=float)
+        force = self._force
+        if self._ff:
+            tau = self._finger_gravity()
+            self._sent_gravity = tau
+            q = q + tau / np.maximum(k, 1e-9)
+            force = force + np.abs(tau)
         self.robot.backend.set_joint_targets(
             self.robot.body,
             q,
@@ -417,10 +448,23 @@ class Gripper:
             joints=list(self.joints),
             stiffness=list(self.config.stiffness),
             damping=list(self.config.damping),
-            force_limit=self._force.tolist(),
+            force_limit=force.tolist(),
         )
-        self._link_sent = None
-        self._aim_linkages()
+
+    def _finger_gravity(self) -> np.ndarray:
+        """Gravity holding force/torque of each of the hand's joints (0 where the backend cannot say)."""
+        r = self.robot
+        if not r.backend.capabilities.gravity_torques:
+            return np.zeros(len(self.joints))
+        return np.asarray(r._gravity_all()[r.joint_index(list(self.joints))], dtype=float)
+
+    def _refresh_gravity(self) -> None:
+        """Re-send the targets when the fingers' gravity load moved (> 0.01 N): the wrist turned."""
+        if not self._ff or self.config.follow:
+            return
+        tau = self._finger_gravity()
+        if self._sent_gravity is None or np.max(np.abs(tau - self._sent_gravity)) > 0.01:
+            self._send(self._targets)
 
     def _aim_linkages(self) -> None:
         """Aim each linkage's fingertip at the arc position of its finger's measured lateral joint.
@@ -488,6 +532,8 @@ class Gripper:
         # the same measured joints would give the same targets again
         if be is None or cb is None or cb[0] is not be or self._aimed_at != be.time:
             self._aim_linkages()
+        if be is not None and self.robot.body is not None:
+            self._refresh_gravity()
         if not self.config.follow or self.robot.body is None:
             return
         pos = self.robot.joint_positions(self.joints)
@@ -537,11 +583,100 @@ class Gripper:
         for k, a in enumerate(self.config.actuators):
             if a in self.config.grasp_actuators:
                 u[k] = self.config.closed[k]
-        self.set_command(u, force_limit)
-        res = self._wait(obj, timeout, u)
+        cfg = self.config
+        if cfg.close_speed is not None and len(cfg.finger_links) == len(self.joints):
+            res = self._close_tracked(u, force_limit, obj, timeout)
+        else:
+            self.set_command(u, force_limit)
+            res = self._wait(obj, timeout, u)
         if self.config.kind == "parallel" and res.contact and not res.closed:
             res = self._squeeze(obj, force_limit, res)
         return res
+
+    def _close_tracked(
+        self, u: np.ndarray, force_limit, obj: BodyId | None, timeout: float
+    ) -> GraspResult:
+        """Close with each joint's target moving at ``close_speed``; a finger stops where it touches.
+
+        Why: a step target saturates each drive at its force cap from the
+        start, so each finger accelerates freely (PR2: a 0.2 kg finger at 3 N
+        reached ~0.6 m/s) and hits the object alone; with the fingers closing
+        vertically, gravity adds to one and subtracts from the other (2.1 N
+        each), so the upper finger arrived first and knocked a cube held by
+        the other hand 2.5 degrees round that hand's pad axis (SAPIEN; see
+        docs/strategies.md, "One-hand holds"). Here both targets move together
+        at the published gap speed; the finger whose link touches ``obj`` (or
+        anything but the robot) gets its target ``force / stiffness`` past where
+        it touched, an unsaturated spring pressing with ``force``, while the
+        other finger carries on until it touches too.
+        """
+        cfg, r = self.config, self.robot
+        be = r.backend
+        q_goal = np.clip(cfg.joint_targets(u), self.lower, self.upper)
+        f = np.broadcast_to(
+            np.asarray(cfg.force_limit if force_limit is None else force_limit, float),
+            (len(self.joints),),
+        ).copy()
+        k = np.asarray(cfg.stiffness, dtype=float)
+        names = list(self.joints)
+        per = max(1, int(round(r.control_period / be.config.timestep)))
+        tick = per * be.config.timestep
+        step = float(cfg.close_speed) * tick
+        q = r.joint_positions(names)
+        tgt = q.copy()
+        sign = np.sign(q_goal - q)  # the closing direction of each joint
+        stopped = np.zeros(len(names), dtype=bool)
+        self.command = np.asarray(u, dtype=float)
+        self._ff = (
+            cfg.gravity_compensated
+        )  # the targets below stay unsaturated: feed-forward is exact
+        self._force = 1.5 * f  # an unsaturated spring presses with f at the f / k offset below
+        t, rest = 0.0, 0.0
+        while t < timeout:
+            free = ~stopped
+            tgt[free] = np.where(
+                sign[free] > 0,
+                np.minimum(tgt[free] + step, q_goal[free]),
+                np.maximum(tgt[free] - step, q_goal[free]),
+            )
+            self._targets = tgt.copy()
+            self._send(tgt)
+            self._aim_linkages()
+            r.step(per)
+            t += tick
+            q, v = r.joint_motion(names)
+            links = self._touching_links(obj)
+            for i, link in enumerate(cfg.finger_links):
+                if not stopped[i] and link in links:
+                    stopped[i] = True
+                    tgt[i] = q[i] + sign[i] * f[i] / k[i]
+            if stopped.all():
+                break
+            at_goal = np.all(stopped | (np.abs(tgt - q_goal) < 1e-12))
+            rest = rest + tick if at_goal and np.max(np.abs(v)) < 0.02 else 0.0
+            if rest >= 0.1:
+                break
+        self._targets = tgt.copy()
+        self._send(tgt)
+        self._aim_linkages()
+        res = self._wait(obj, 0.3, u)  # the spring presses; rest
+        return GraspResult(
+            res.contact, res.closed, res.actuators, res.joint_positions, t + res.time
+        )
+
+    def _touching_links(self, obj: BodyId | None) -> set[str]:
+        """The hand's finger links that press on ``obj`` (or anything but the robot) now.
+
+        Pressing, not merely listed: PhysX reports contact points from ``contact_offset`` (2 mm) away,
+        and a finger stopped there with a 1.5 mm spring (3 N) never touched (measured, SAPIEN).
+        """
+        r = self.robot
+        links = set(self.config.finger_links)
+        return {
+            c.link_a
+            for c in r.backend.contacts(r.body, obj)
+            if c.link_a in links and c.body_b != r.body and c.normal_force > 0.0
+        }
 
     def _squeeze(self, obj: BodyId | None, force_limit, first: GraspResult) -> GraspResult:
         """Re-aim both fingers at the object's middle, a spring squeeze short of it.
@@ -559,7 +694,7 @@ class Gripper:
         k = np.asarray(self.config.stiffness, dtype=float)
         q = first.joint_positions
         u = np.array([float(np.mean(q)) - float(np.mean(f / k))])
-        self.set_command(u, 1.5 * f)
+        self.set_command(u, 1.5 * f, feed_forward=True)
         res = self._wait(obj, 0.5, u)
         return GraspResult(
             res.contact, False, res.actuators, res.joint_positions, first.time + res.time

@@ -13,6 +13,7 @@ from .descriptions.pr2 import (
     FINGER_RADIUS,
     FINGER_TRAVEL,
     FINGER_Y,
+    GRIPPER_CLOSE_SPEED,
     PAD_FACE_Y,
     PAD_GAP,
 )
@@ -99,6 +100,10 @@ def pr2_gripper_part(s: str, name: str, grip_force: float = 20.0) -> GripperConf
         tcp_link=f"{s}_gripper_tcp",
         kind="parallel",
         linkages=linkages,
+        # one motor drives both fingers through the screw and the mimic linkage: the finger weights cancel
+        gravity_compensated=True,
+        # l_gripper_joint (the gap) velocity="0.2" m/s (pr2_description gripper_v0/gripper.urdf.xacro): 0.1 per finger
+        close_speed=GRIPPER_CLOSE_SPEED,
     )
 
 

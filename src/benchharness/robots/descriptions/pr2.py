@@ -83,6 +83,8 @@ def _soft(key: str, lower: float, upper: float) -> dict[str, float]:
 #: circle of radius FINGER_RADIUS about the pivot. We model exactly that pad motion with two prismatic
 #: joints per finger (see :func:`_gripper`).
 GRIPPER_MAX_OPENING = 0.09  # m; l_gripper_joint upper="0.09" (gripper_v0/gripper.urdf.xacro)
+#: m/s per finger: l_gripper_joint (the gap between the fingers) velocity="0.2" (gripper_v0/gripper.urdf.xacro)
+GRIPPER_CLOSE_SPEED = 0.2 / 2
 PAD_GAP = 0.001  # m; each pad's inner face sits this far out from the finger joint value (pads never interpenetrate)
 FINGER_TRAVEL = (GRIPPER_MAX_OPENING - 2 * PAD_GAP) / 2  # per finger
 TCP_X = 0.18  # m; l_gripper_tool_frame origin xyz="0.18 0 0" (pr2_description gripper_v0/gripper.urdf.xacro)
@@ -133,6 +135,8 @@ def pad_setback(opening: float) -> float:
     return TCP_X - (tip_x(opening / 2.0) + PAD_CENTRE_X)
 
 
+#: (centre, size) in the palm frame of the palm's collision box (a stand-in for the palm mesh, see _gripper)
+PALM_BOX = ((0.08, 0.0, 0.0), (0.06, 0.07, 0.05))
 BAR_X0 = FINGER_X + 0.02  # m: the finger bar's palm end (a stand-in for the proximal link's shape)
 BAR_SIZE_YZ = (0.008, 0.02)  # m
 
@@ -432,7 +436,7 @@ def _gripper(m: UrdfBuilder, s: str) -> None:
     )
     m.link(
         f"{s}_gripper_palm_link",
-        [Geom("box", (0.06, 0.07, 0.05), (0.08, 0.0, 0.0))],
+        [Geom("box", PALM_BOX[1], PALM_BOX[0])],
         0.58007,
         com=(0.06623, 0.00053, -0.00119),
         inertia=(

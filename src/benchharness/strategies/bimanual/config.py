@@ -42,6 +42,20 @@ class BimanualConfig:
     #: open fingers must clear the cube while the wrist turns (the PR2's open to 90 mm, and a swing of the
     #: wrist at its 7 cm pre-grasp can sweep the 57 mm cube).
     far_distance: float = 0.15
+    #: a free hand's joint-space move to its stand-off, and a retreat, must keep the hand this far (m) from
+    #: the believed cube all the way (one that starts nearer: at most 5 mm nearer than it starts), checked
+    #: on the straight joint path with forward kinematics and the grasp module's ``hand_points``; a
+    #: stand-off move that comes nearer backs out first (``detour_distances``), a retreat is cut short.
+    #: Why: a stand-off
+    #: whose IK solution lies on another arm branch is reached by a joint-space swing of the whole hand;
+    #: measured (PR2, PyBullet, Rubiks-5-5 sensor-aided seed 0 trial 5): a shift-in stand-off move turning
+    #: the wrist and forearm rolls 2.3 and 2.0 rad brought the open fingertip onto the cube held by the other
+    #: hand (25 N) and turned it 32 degrees in that grip (docs/strategies.md, "One-hand holds"). 0: no check.
+    sweep_clearance: float = 0.02
+    #: distances (m) from the believed cube centre, tried in order, at which a free hand whose move to its
+    #: stand-off would sweep the cube makes that move instead: straight back along its own approach to
+    #: the distance, there to the stand-off's orientation (the joint-space swing), then straight in.
+    detour_distances: tuple[float, ...] = (0.25, 0.35, 0.45)
     #: a free hand swings round the cube on an arc about its believed centre in Cartesian waypoints at most
     #: this many degrees apart (:meth:`.machine.BimanualRubiksMachine._swing`): one joint-space move from
     #: one side of the cube to another sweeps the hand along whatever path the joints take.

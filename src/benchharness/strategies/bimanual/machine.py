@@ -122,6 +122,10 @@ class GraspModule(Protocol):
     axes (0 = x, 1 = y, 2 = z) along which the hand approaches the face it
     grips and across which its fingers close; the wrist's last joint rolls
     about the approach axis.
+
+    Optional: ``hand_points() -> np.ndarray`` (N x 3, tool frame, m), points filling the open
+    hand; with it the machine keeps a free hand's moves to its stand-offs from sweeping through
+    the cube (:meth:`BimanualRubiksMachine.transit`). A module without it is not checked.
     """
 
     approach_axis: int
@@ -560,7 +564,7 @@ class BimanualRubiksMachine:
             or r0 > cfg.swing_radius
             or math.degrees(angle) < cfg.swing_min_deg
         ):
-            self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+            self.transit(hand, far, label=label, seed_q=seed_q)
             return
         if cfg.swing_routes:
             for way in self._swing_route(hand, far, label, u0, u1, r0, r1):
@@ -573,7 +577,128 @@ class BimanualRubiksMachine:
                 (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
             ).success[0]:
                 self.send(hand, way, label=f"{label} arc", settle=0.02)
-        self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
+        self.transit(hand, far, label=label, seed_q=seed_q)
+
+    def _ik_q(self, hand: Hand, pose: Pose, seed: np.ndarray) -> np.ndarray | None:
+        """The arm's IK solution for the (believed) tool pose ``pose`` from ``seed``; None if unreachable."""
+        base = hand.arm.base_pose()
+        res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
+        return np.asarray(res.q[0], dtype=float) if bool(res.success[0]) else None
+
+    def sweep_clearance(
+        self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int = 16
+    ) -> float:
+        """Least distance (m) from the believed cube (a box) of the hand's ``points`` (tool frame) along
+        the straight joint path ``q0`` -> ``q1`` (the path :meth:`RobotArm.move_to_joints` tracks)."""
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        t = np.asarray(hand.arm.fk(q0 + s * (q1 - q0)), dtype=float)
+        w = hand.arm.base_pose().as_matrix() @ t
+        p = np.einsum("nij,pj->npi", w[:, :3, :3], points) + w[:, None, :3, 3]
+        local = self.est.rotation.inv().apply(p.reshape(-1, 3) - self.est.p)
+        return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - CUBE_HALF, 0.0), axis=1)))
+
+    def _hand_points(self) -> np.ndarray | None:
+        """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
+        points_of = getattr(self.grasp, "hand_points", None)
+        if points_of is None or self.config.sweep_clearance <= 0:
+            return None
+        return np.asarray(points_of(), dtype=float)
+
+    def _clears(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray) -> bool:
+        """Whether the straight joint path ``q0`` -> ``q1`` keeps the hand clear of the believed cube:
+        never nearer than ``sweep_clearance`` or, for a hand that starts nearer (backing out from round
+        the cube: open pads 16 mm from its faces), than it starts less 5 mm (at most half of it). A
+        joint-space step of a few centimetres strays a few millimetres from its straight Cartesian line
+        (measured: 2-3 mm for 2 cm steps of a PR2 giver's retreat); a sweep through the cube reaches 0."""
+        start = self.sweep_clearance(hand, q0, q0, points, n=1)
+        need = min(start - min(5e-3, 0.5 * start), self.config.sweep_clearance)
+        return self.sweep_clearance(hand, q0, q1, points) >= need
+
+    def _line(
+        self, hand: Hand, a: Pose, b: Pose, q: np.ndarray, points: np.ndarray, step: float = 0.02
+    ) -> list[tuple[Pose, np.ndarray]] | None:
+        """Waypoints (pose, IK solution) at most ``step`` apart on the straight line from ``a`` to ``b``
+        (same orientation), each solved from the last and each joint path clear; None if not."""
+        n = max(1, math.ceil(float(np.linalg.norm(b.p - a.p)) / step))
+        out = []
+        for i in range(1, n + 1):
+            way = Pose(a.p + (b.p - a.p) * i / n, b.q)
+            q1 = self._ik_q(hand, way, q)
+            if q1 is None or not self._clears(hand, q, q1, points):
+                return None
+            out.append((way, q1))
+            q = q1
+        return out
+
+    def transit(
+        self, hand: Hand, target: Pose, *, label: str, seed_q: np.ndarray | None = None
+    ) -> None:
+        """Move a free hand to the stand-off ``target`` without sweeping it through the cube.
+
+        The move is one joint-space motion to the IK solution nearest ``seed_q``
+        (the grip's planned branch). If that straight joint path brings the
+        hand (the grasp module's ``hand_points``, open) nearer the believed
+        cube than ``sweep_clearance`` (or than it starts, if it starts nearer),
+        the hand instead backs straight out along its approach in 2 cm steps to
+        the first of ``detour_distances`` from which the swing to the stand-off's
+        orientation and the straight way back in (in 2 cm steps) stay clear, and
+        a ``detour`` event is recorded. If none does, the direct move is made and
+        a warning recorded.
+        """
+        cfg = self.config
+        points = self._hand_points()
+        if points is None:
+            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            return
+        q0 = hand.arm.positions()
+        plan_seed = q0 if seed_q is None else seed_q
+        q1 = self._ik_q(hand, target, plan_seed)
+        if q1 is None or self._clears(hand, q0, q1, points):
+            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            return
+        clear = self.sweep_clearance(hand, q0, q1, points)
+        c = self.est.p
+        r0 = float(np.linalg.norm(hand.cmd.p - c))
+        r1 = float(np.linalg.norm(target.p - c))
+        for d in cfg.detour_distances:
+            out = self.back_off(hand.cmd, max(0.0, d - r0))
+            turned = self.back_off(target, max(0.0, d - r1))
+            leg_out = self._line(hand, hand.cmd, out, q0, points)
+            if leg_out is None:
+                continue
+            qa = leg_out[-1][1]
+            qb = self._ik_q(hand, turned, plan_seed)
+            if qb is None or not self._clears(hand, qa, qb, points):
+                continue
+            leg_in = self._line(hand, turned, target, qb, points)
+            if leg_in is None:
+                continue
+            self.ctx.recorder.event(
+                "detour",
+                hand=hand.side,
+                label=label,
+                clearance_mm=round(1000 * clear, 1),
+                distance_m=d,
+            )
+            for way, q in leg_out:
+                self.send(hand, way, label=f"{label} detour out", settle=0.02, seed_q=q)
+            self.send(hand, turned, label=f"{label} detour turn", settle=0.02, seed_q=qb)
+            for k, (way, q) in enumerate(leg_in):
+                last = k == len(leg_in) - 1
+                self.send(
+                    hand,
+                    way,
+                    label=label if last else f"{label} detour in",
+                    settle=0.05 if last else 0.02,
+                    seed_q=q,
+                )
+            return
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: the move to the {label} passes {1000 * clear:.0f} mm from the "
+            f"cube and no detour clears it",
+        )
+        self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
 
     def _arc(self, c: np.ndarray, dirs: list, quats: list, r0: float, r1: float) -> list[Pose]:
         """Waypoints (tool poses, the ends left out) on great-circle legs about ``c`` through the unit
@@ -686,8 +811,10 @@ class BimanualRubiksMachine:
         The open hand is still round the cube, so the retreat must be a
         straight move: if the stand-off's IK solution is more than
         ``max_waypoint_jump`` from the arm's joints (a joint limit on the way
-        out, another branch beyond), it backs off in 2 cm steps only as far
-        as the arm follows smoothly and logs a warning.
+        out, another branch beyond), or its joint path would bring the hand
+        nearer the cube (with the grasp module's ``hand_points``: see
+        :meth:`transit`), it backs off in 2 cm steps only as far as the arm
+        follows smoothly and clear, and logs a warning.
         """
         if hand.holding:
             self.grasp.open(self, hand)
@@ -700,17 +827,31 @@ class BimanualRubiksMachine:
             or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)
         ):
             return
-        if self._smooth(hand, back):
-            self.send(hand, back, label="retreat", settle=0.05)
+        points = self._hand_points()
+
+        def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
+            """Smooth, and (with hand points) clear of the cube; the IK solution to seed the move with."""
+            if not self._smooth(hand, target):
+                return False, None
+            if points is None:
+                return True, None
+            q0 = hand.arm.positions()
+            q1 = self._ik_q(hand, target, q0)
+            return (q1 is not None and self._clears(hand, q0, q1, points)), q1
+
+        ok, q_back = way_out(back)
+        if ok:
+            self.send(hand, back, label="retreat", settle=0.05, seed_q=q_back)
             return
         step = 0.02
         approach = ref.rotation.apply(along(self.grasp.approach_axis, 1.0))
         dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
         while dist + step <= d + 1e-9:
             nxt = self.back_off(ref, dist + step)
-            if not self._smooth(hand, nxt):
+            ok, q_next = way_out(nxt)
+            if not ok:
                 break
-            self.send(hand, nxt, label="retreat step", settle=0.02)
+            self.send(hand, nxt, label="retreat step", settle=0.02, seed_q=q_next)
             dist += step
         self.ctx.recorder.event(
             "warning",

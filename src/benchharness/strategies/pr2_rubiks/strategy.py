@@ -39,6 +39,16 @@ __all__ = [
 ]
 
 
+def _open_hand_points() -> np.ndarray:
+    from ...robots.descriptions.pr2 import GRIPPER_MAX_OPENING, PALM_BOX, TCP_X, finger_boxes
+
+    boxes = [*finger_boxes(GRIPPER_MAX_OPENING), PALM_BOX]
+    g = np.linspace(-0.5, 0.5, 5)
+    grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    pts = np.concatenate([np.asarray(c) + grid * np.asarray(s) for c, s in boxes])
+    return pts - np.array([TCP_X, 0.0, 0.0])
+
+
 class PR2Grasp:
     """The PR2's grasp module: side grips of a parallel gripper (tool x = approach, y = fingers)."""
 
@@ -55,6 +65,12 @@ class PR2Grasp:
 
     def hand_state(self) -> Any:
         return None
+
+    def hand_points(self) -> np.ndarray:
+        """Points (tool frame, m) filling the open hand's collision boxes: both pads and finger bars at
+        the 90 mm opening and the palm (:func:`...robots.descriptions.pr2.finger_boxes`); the machine keeps
+        them clear of the cube when the free hand moves to a stand-off (``sweep_clearance``)."""
+        return _open_hand_points()
 
     def take_relation(self) -> str | None:
         # in a hand-over the giver's finger lies on the face the taker comes to: only crossing fingers pass it
