@@ -98,8 +98,8 @@ class BimanualConfig:
     #: joint-speed fraction for arm motions.
     velocity_scale: float = 0.4
     #: an arm motion that ends farther than this from its target is logged as a warning event (m); None: no
-    #: check. The PR2 baselines leave it off: their giver's extra IK seeds are drawn from a generator seeded
-    #: with the number of events recorded so far, so a new event would change their results.
+    #: check. The PR2 baselines leave it off (their recorded results predate it; the events do not move the
+    #: planner, whose draws come from the machine's ``plan_rng``).
     reach_warning: float | None = None
     #: a move whose IK did not converge is carried on with (a warning event) if the arm ended within this
     #: distance of its target (m), as a move with an injected error would; None: every such move fails the

@@ -260,6 +260,10 @@ class BimanualRubiksMachine:
         cfg, rec, b = self.config, ctx.recorder, self.b
         err = cfg.errors
         rng = ctx.rng
+        #: the planner's own stream (IK restarts, alternative arm postures): spawned once from the
+        #: trial's rng, so its draws neither shift the error draws nor depend on how many events or
+        #: measurements the trial has logged (spawning does not advance ``rng``)
+        self.plan_rng: np.random.Generator = rng.spawn(1)[0]
         self.hands: dict[str, Hand] = {}
         for side in ("left", "right"):
             dp = rng.normal(0.0, err.calib_pos_std, 3) if err.calib_pos_std else np.zeros(3)

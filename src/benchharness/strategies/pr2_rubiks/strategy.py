@@ -145,7 +145,7 @@ class PR2Grasp:
         if turn is not None and cfg.giver_seeds > 0:
             # a giver also tries other arm configurations (the 7-DOF arm's self-motion) for each
             # placement: the turn may only be smooth from another elbow/shoulder posture
-            rng = np.random.default_rng(len(m.ctx.recorder.events))  # deterministic per trial
+            rng = m.plan_rng
             lo = np.where(np.isfinite(hand.arm.lower), hand.arm.lower, -np.inf)
             hi = np.where(np.isfinite(hand.arm.upper), hand.arm.upper, np.inf)
             seeds += [
