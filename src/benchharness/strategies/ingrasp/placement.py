@@ -269,15 +269,8 @@ def place_object(
             score = 2.0 * sol.cost + float(np.sum((3.0 * penetration(m1)) ** 2))
             ranked.append((round(score, 10), i, j, sol.x, r0, m1))
     ranked.sort(key=lambda e: e[:3])
-    todo = ranked[:refine]
-    if grip_cone_deg is not None:
-        # also refine the touching candidates that grip best (penetration is only fixed in stage 2)
-        touching = [e for e in ranked if float(np.max(np.abs(gaps(e[5])))) <= fit_tol]
-        touching.sort(key=lambda e: (round(grip_excess(e[5]), 6), e[0], e[1], e[2]))
-        todo = todo + [e for e in touching[: 2 * refine] if all(e is not t for t in todo)]
-    # stage 2: the best few, with the hand's other parts kept out of the object
-    best: tuple | None = None
-    for _, _, _, x1, r0, _ in todo:
+
+    def refine_one(x1: np.ndarray, r0: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
         sol = least_squares(
             residuals,
             x1,
@@ -287,23 +280,41 @@ def place_object(
             max_nfev=200,
             x_scale=scale,
         )
-        cost = float(2.0 * sol.cost)
-        m2 = pose_of(sol.x, r0)
-        if grip_cone_deg is None:
-            key: tuple = (round(cost, 10), float(np.linalg.norm(sol.x[3:])))
-        else:
-            fits = (
-                float(np.max(np.abs(gaps(m2)))) <= fit_tol
-                and float(np.max(penetration(m2, vertices) - clearance, initial=0.0)) <= fit_tol
-            )
-            key = (
-                not fits,
-                round(grip_excess(m2), 6) if fits else 0.0,  # none fits: the best fit, as without
-                round(cost, 10),
-                float(np.linalg.norm(sol.x[3:])),
-            )
+        return float(2.0 * sol.cost), sol.x, pose_of(sol.x, r0)
+
+    def fits(m2: np.ndarray) -> bool:
+        return (
+            float(np.max(np.abs(gaps(m2)))) <= fit_tol
+            and float(np.max(penetration(m2, vertices) - clearance, initial=0.0)) <= fit_tol
+        )
+
+    # stage 2: the best few, with the hand's other parts kept out of the object
+    best: tuple | None = None
+    for _, _, _, x1, r0, _ in ranked[:refine]:
+        cost, x, m2 = refine_one(x1, r0)
+        key: tuple = (round(cost, 10), float(np.linalg.norm(x[3:])))
         if best is None or key < best[0]:
-            best = (key, cost, sol.x, r0)
+            best = (key, cost, x, r0, m2)
+    assert best is not None
+    if grip_cone_deg is not None and grip_excess(best[4]) > 0.0:
+        # the best fit does not grip: also refine the touching candidates that grip best
+        # (penetration is only fixed in stage 2) and take the touching pose that grips best
+        touching = [e for e in ranked if float(np.max(np.abs(gaps(e[5])))) <= fit_tol]
+        touching.sort(key=lambda e: (round(grip_excess(e[5]), 6), e[0], e[1], e[2]))
+        pool = [(best[1], best[2], best[3], best[4])]
+        for _, _, _, x1, r0, _ in touching[: 2 * refine]:
+            cost, x, m2 = refine_one(x1, r0)
+            pool.append((cost, x, r0, m2))
+        for cost, x, r0, m2 in pool:
+            ok = fits(m2)
+            key = (
+                not ok,
+                round(grip_excess(m2), 6) if ok else 0.0,  # none fits: the best fit, as without
+                round(cost, 10),
+                float(np.linalg.norm(x[3:])),
+            )
+            if key < best[0] or len(best[0]) == 2:
+                best = (key, cost, x, r0, m2)
     assert best is not None
     m = pose_of(best[2], best[3])
     return InGraspPlacement(
