@@ -252,3 +252,43 @@ def test_refuses_other_robots(planner, task, plan):
             )
     finally:
         be.close()
+
+
+#: Set-up drops of the published grasps before the placement took the friction cone into account
+#: (docs/ingrasp.md, "Set-up drops"): every fingertip touched, but on faces the squeeze only slides along.
+SETUP_DROP_TASKS = ("banana-06", "lego_duplo-01")
+
+
+@pytest.mark.parametrize("task_id", SETUP_DROP_TASKS)
+def test_placement_squeeze_inside_friction_cone(task_id):
+    """The default placement touches every fingertip *and* the grip presses inside the mu = 1 cone.
+
+    Contacts-only (the old placement) puts at least one squeeze direction 49-79 deg off the surface
+    normal on these tasks, outside the 45 deg cone of the default friction 1.0.
+    """
+    t = {x.task_id: x for x in published_tasks()}[task_id]
+    planner = InGraspPlanner("relaxed-rigidity")
+    problem = planner.problem(t)
+    new = InGraspExecutor(planner.hand).placement(problem, t.object)
+    old = InGraspExecutor(planner.hand, ExecConfig(placement_grip_cone_deg=None)).placement(
+        problem, t.object
+    )
+    assert new.max_gap < 5e-4 and new.penetration <= 5e-4
+    assert np.all(new.grip_angles_deg <= 45.0), new.grip_angles_deg
+    assert np.max(old.grip_angles_deg) > 45.0, old.grip_angles_deg
+
+
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+def test_setup_holds_banana_06(backend):
+    """banana-06 dropped at set-up on both engines (all fingertip forces 0 N one control period after
+    the "human" let go); placed inside the friction cones it is held by all three fingertips."""
+    t = {x.task_id: x for x in published_tasks()}["banana-06"]
+    planner = InGraspPlanner("relaxed-rigidity", exec_config=ExecConfig(hold_s=0.2))
+    plan = planner.plan_task(t)
+    out = _run(planner, t, plan, backend)
+    assert not out.dropped, out.message
+    assert out.extra["setup_tip_contacts"] == ["link_15_tip", "link_3_tip", "link_7_tip"]
+    before = _run(
+        planner, t, plan, backend, config=ExecConfig(hold_s=0.2, placement_grip_cone_deg=None)
+    )
+    assert before.dropped and before.phase == "setup", before.message

@@ -111,6 +111,9 @@ class ExecConfig:
         True  #: reached = executed displacement applied to H_i (paper's set-up correction)
     )
     max_placement_gap: float = 0.002  #: m, placement fit worse than this is refused (unreachable)
+    #: deg, friction cone half angle the set-up placement keeps the squeeze directions inside
+    #: (``placement.place_object``; 45 = atan of the default friction 1.0); None: contacts only
+    placement_grip_cone_deg: float | None = 45.0
 
     def __post_init__(self) -> None:
         if self.palm not in PALM_ROTATIONS:
@@ -218,6 +221,7 @@ class InGraspExecutor:
             object_name,
             tuple(np.round(problem.q_rest, 12)),
             problem.fingers,
+            self.config.placement_grip_cone_deg,
         )
 
     # ----------------------------------------------------------------- the trial
@@ -308,6 +312,7 @@ class InGraspExecutor:
             "placement_gap_mm": round(place.max_gap * 1e3, 4),
             "placement_penetration_mm": round(place.penetration * 1e3, 3),
             "placement_rotation_change_deg": round(place.rotation_change_deg, 3),
+            "placement_grip_angles_deg": np.round(place.grip_angles_deg, 1).tolist(),
             "setup_noise_pos_mm": (dp * 1e3).round(4).tolist(),
             "setup_noise_rot_deg": round(
                 float(np.degrees(Rotation.from_matrix(dr).magnitude())), 4
@@ -480,14 +485,26 @@ _PLACEMENTS: dict[tuple, InGraspPlacement] = {}
 
 
 def _cached_placement(
-    hand: HandKinematics, task_id: str, object_name: str, q_rest: tuple, fingers: tuple
+    hand: HandKinematics,
+    task_id: str,
+    object_name: str,
+    q_rest: tuple,
+    fingers: tuple,
+    grip_cone_deg: float | None = None,
 ) -> InGraspPlacement:
     from benchharness.objects import load_object
 
-    key = (task_id, object_name, q_rest, fingers)
+    key = (task_id, object_name, q_rest, fingers, grip_cone_deg)
     if key not in _PLACEMENTS:
         v, n, c, sym = object_surface_arrays(load_object(object_name))
         _PLACEMENTS[key] = place_object(
-            hand, np.asarray(q_rest, float), fingers, v, n, c, symmetric=sym
+            hand,
+            np.asarray(q_rest, float),
+            fingers,
+            v,
+            n,
+            c,
+            symmetric=sym,
+            grip_cone_deg=grip_cone_deg,
         )
     return _PLACEMENTS[key]

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import itertools
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
@@ -54,6 +54,10 @@ class InGraspPlacement:
     penetration: float  #: m, deepest object vertex inside any other hand part (0 = clear)
     cost: float  #: final least-squares cost
     rotation_change_deg: float  #: how far the pose turned away from its axis-aligned candidate
+    #: (k,) deg, per used fingertip: angle between the squeeze direction (towards the fingertip
+    #: centroid) and the surface's inward normal at the contact (<= the friction cone's half
+    #: angle: the grip presses the object instead of sliding along it)
+    grip_angles_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def max_gap(self) -> float:
@@ -151,6 +155,8 @@ def place_object(
     urdf: str | None = None,
     max_vertices: int = 400,
     refine: int = 4,
+    grip_cone_deg: float | None = None,
+    fit_tol: float = 0.0005,
 ) -> InGraspPlacement:
     """Solve the object pose in the palm frame so ``fingers``' tips touch the surface at ``q16``.
 
@@ -163,6 +169,16 @@ def place_object(
     mesh vertices (every n-th) used for penetration while solving (all are
     used for the reported figure); ``refine``: candidates solved with
     penetration after the contacts-only first pass.
+
+    ``grip_cone_deg`` (None: off): the friction cone's half angle. With it the
+    placement is chosen like a person setting the object into the grasp: of
+    the candidate poses whose fingertips touch (gaps and penetration within
+    ``fit_tol``), the one whose squeeze directions (each fingertip towards the
+    fingertip centroid, the direction the grip pushes) lie best inside the
+    friction cones around the surface normals (least summed excess angle),
+    then the best fit. Without it a pose may touch all fingertips on faces
+    the squeeze only slides along, and the grip ejects the object as soon as
+    it is released (docs/ingrasp.md, "Set-up drops").
     """
     geo = hand_geometry(urdf)
     frames = link_frames(hand, q16)
@@ -184,6 +200,8 @@ def place_object(
     inv_boxes = [(np.linalg.inv(m), h) for m, h in obst_boxes]
     tree = cKDTree(vertices)
     centroid = tip_c.mean(axis=0)
+    sq_dir = centroid - tip_c
+    sq_dir = sq_dir / np.maximum(np.linalg.norm(sq_dir, axis=1, keepdims=True), 1e-12)
     nrm = np.cross(tip_c[1] - tip_c[0], tip_c[-1] - tip_c[0])
     nrm = nrm / max(np.linalg.norm(nrm), 1e-12)
 
@@ -197,6 +215,18 @@ def place_object(
         local = (tip_c - m[:3, 3]) @ m[:3, :3]  # tip centres in the object frame
         _, idx = tree.query(local)
         return np.einsum("ij,ij->i", local - vertices[idx], normals[idx]) - tip_r
+
+    def grip_angles(m: np.ndarray) -> np.ndarray:
+        local = (tip_c - m[:3, 3]) @ m[:3, :3]
+        _, idx = tree.query(local)
+        inward = -(normals[idx] @ m[:3, :3].T)
+        inward = inward / np.maximum(np.linalg.norm(inward, axis=1, keepdims=True), 1e-12)
+        return np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", inward, sq_dir), -1.0, 1.0)))
+
+    def grip_excess(m: np.ndarray) -> float:
+        if grip_cone_deg is None:
+            return 0.0
+        return float(np.sum(np.maximum(grip_angles(m) - grip_cone_deg, 0.0)))
 
     stride = max(1, len(vertices) // max_vertices)
     sub = vertices[::stride]
@@ -235,12 +265,12 @@ def place_object(
                 max_nfev=100,
                 x_scale=scale,
             )
-            score = 2.0 * sol.cost + float(np.sum((3.0 * penetration(pose_of(sol.x, r0))) ** 2))
-            ranked.append((round(score, 10), i, j, sol.x, r0))
+            m1 = pose_of(sol.x, r0)
+            score = 2.0 * sol.cost + float(np.sum((3.0 * penetration(m1)) ** 2))
+            ranked.append((round(score, 10), i, j, sol.x, r0, m1))
     ranked.sort(key=lambda e: e[:3])
-    # stage 2: the best few, with the hand's other parts kept out of the object
-    best: tuple[float, float, np.ndarray, np.ndarray] | None = None
-    for _, _, _, x1, r0 in ranked[:refine]:
+
+    def refine_one(x1: np.ndarray, r0: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
         sol = least_squares(
             residuals,
             x1,
@@ -250,18 +280,50 @@ def place_object(
             max_nfev=200,
             x_scale=scale,
         )
-        cost = float(2.0 * sol.cost)
-        key = (round(cost, 10), float(np.linalg.norm(sol.x[3:])))
-        if best is None or key < best[:2]:
-            best = (key[0], key[1], sol.x, r0)
+        return float(2.0 * sol.cost), sol.x, pose_of(sol.x, r0)
+
+    def fits(m2: np.ndarray) -> bool:
+        return (
+            float(np.max(np.abs(gaps(m2)))) <= fit_tol
+            and float(np.max(penetration(m2, vertices) - clearance, initial=0.0)) <= fit_tol
+        )
+
+    # stage 2: the best few, with the hand's other parts kept out of the object
+    best: tuple | None = None
+    for _, _, _, x1, r0, _ in ranked[:refine]:
+        cost, x, m2 = refine_one(x1, r0)
+        key: tuple = (round(cost, 10), float(np.linalg.norm(x[3:])))
+        if best is None or key < best[0]:
+            best = (key, cost, x, r0, m2)
+    assert best is not None
+    if grip_cone_deg is not None and grip_excess(best[4]) > 0.0:
+        # the best fit does not grip: also refine the touching candidates that grip best
+        # (penetration is only fixed in stage 2) and take the touching pose that grips best
+        touching = [e for e in ranked if float(np.max(np.abs(gaps(e[5])))) <= fit_tol]
+        touching.sort(key=lambda e: (round(grip_excess(e[5]), 6), e[0], e[1], e[2]))
+        pool = [(best[1], best[2], best[3], best[4])]
+        for _, _, _, x1, r0, _ in touching[: 2 * refine]:
+            cost, x, m2 = refine_one(x1, r0)
+            pool.append((cost, x, r0, m2))
+        for cost, x, r0, m2 in pool:
+            ok = fits(m2)
+            key = (
+                not ok,
+                round(grip_excess(m2), 6) if ok else 0.0,  # none fits: the best fit, as without
+                round(cost, 10),
+                float(np.linalg.norm(x[3:])),
+            )
+            if key < best[0] or len(best[0]) == 2:
+                best = (key, cost, x, r0, m2)
     assert best is not None
     m = pose_of(best[2], best[3])
     return InGraspPlacement(
         m,
         gaps(m),
         float(np.max(penetration(m, vertices) - clearance, initial=0.0).clip(min=0.0)),
-        best[0],
+        best[1],
         float(np.degrees(np.linalg.norm(best[2][3:]))),
+        grip_angles(m),
     )
 
 
