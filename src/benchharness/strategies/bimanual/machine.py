@@ -508,27 +508,45 @@ class BimanualRubiksMachine:
         call per waypoint, each seeded with its own previous solution. The chain ends with the giver's
         retreat from the turned grip (``handover_retreat`` back along its approach): a turn that ends
         at a joint limit leaves no straight way out, and the arm's retreat then swings through the cube.
-        ``with_retreat=False``: the turn's waypoints only (a robot's fallback when no grip passes).
+        With the grasp module's ``hand_points`` the retreat is checked as :meth:`release_hand` makes
+        it: in 2 cm steps, each smooth and its joint path clear of the cube (:meth:`_clears`); a grip
+        whose retreat is not gets inf travel (its largest step stays that of its joints). Why:
+        checked as one IK step, a retreat that met the shoulder-lift limit half-way passed (0.68 rad)
+        while the executed retreat's 2 cm steps switched the upper-arm roll by 0.6 rad, swept the
+        open hand to 5 mm of the cube and were cut to 4 cm; the re-grip's stand-off move then found
+        no detour and knocked the cube out of the taker's hand (SAPIEN Rubiks-5-5 sensor-aided seed 0,
+        trial 5). ``with_retreat=False``: the turn's waypoints only (a robot's fallback when no grip
+        passes).
         """
         cfg = self.config
         n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
+        points = self._hand_points() if with_retreat else None
+        # (waypoint of the turn, of n; retreat distance) of each step
+        steps = [(i, 0.0) for i in range(1, n + 1)]
+        if with_retreat and points is None:
+            steps.append((n, cfg.handover_retreat))
+        elif with_retreat:
+            m = max(1, math.ceil(cfg.handover_retreat / 0.02 - 1e-9))
+            steps += [(n, cfg.handover_retreat * j / m) for j in range(1, m + 1)]
         q = np.array(q, dtype=float)
         total = np.zeros(len(grips))
         worst = np.zeros(len(grips))
-        for i in range(1, n + 2 if with_retreat else n + 1):
+        for i, back in steps:
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
-            poses = [
-                rotate_about_point(grips[k], self.est.p, axis, angle * min(i, n) / n) for k in live
-            ]
-            if i > n:  # the retreat
-                poses = [self.back_off(p, cfg.handover_retreat) for p in poses]
+            poses = [rotate_about_point(grips[k], self.est.p, axis, angle * i / n) for k in live]
+            if back > 0:  # the retreat
+                poses = [self.back_off(p, back) for p in poses]
             targets = [(base.inv() * p).as_matrix() for p in poses]
             res = hand.arm.ik(np.stack(targets), seed_q=q[live])
             jump = np.max(np.abs(res.q - q[live]), axis=1)
             reached = np.asarray(res.success, dtype=bool)
             bad = ~reached | (jump > cfg.max_waypoint_jump)
+            if back > 0 and points is not None:
+                for j, k in enumerate(live):
+                    if not bad[j] and np.isfinite(total[k]):
+                        bad[j] = not self._clears(hand, q[k], res.q[j], points)
             total[live] = np.where(bad, np.inf, total[live] + jump)
             worst[live] = np.where(reached, np.maximum(worst[live], jump), np.inf)
             q[live] = res.q
