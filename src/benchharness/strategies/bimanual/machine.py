@@ -483,13 +483,21 @@ class BimanualRubiksMachine:
 
     def _smooth(self, hand: Hand, target: Pose) -> bool:
         """Whether the arm reaches ``target`` from its joints without any joint moving > max_waypoint_jump."""
+        return self.smooth_q(hand, target) is not None
+
+    def smooth_q(self, hand: Hand, target: Pose) -> np.ndarray | None:
+        """The IK solution by which the arm reaches ``target`` from its joints without any joint moving
+        more than ``max_waypoint_jump``, or None. Send the move seeded with it (``send(seed_q=...)``):
+        solved again from the injected-error target, the arm can take another branch (measured: a
+        pre-touch sweep judged smooth swung the upper-arm and wrist rolls 3.1 rad, SAPIEN)."""
         base = hand.arm.base_pose()
         q = hand.arm.positions()
         res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
-        return (
+        ok = (
             bool(res.success[0])
             and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
         )
+        return np.asarray(res.q[0], dtype=float) if ok else None
 
     def turn_travel(
         self,
