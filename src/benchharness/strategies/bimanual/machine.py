@@ -602,11 +602,33 @@ class BimanualRubiksMachine:
             self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
             return
         base = hand.arm.base_pose()
+        points = self._hand_points()
         for way in self._arc(c, [u0, u1], [hand.cmd.q, far.q], r0, r1):
-            if hand.arm.ik(
-                (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
-            ).success[0]:
-                self.send(hand, way, label=f"{label} arc", settle=0.02)
+            q_now = hand.arm.positions()
+            res = hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=q_now)
+            if not res.success[0]:
+                continue
+            if points is not None and not self._clears(hand, q_now, res.q[0], points):
+                # the joint path to the next waypoint sweeps the cube (measured: a giver's re-grip arc
+                # from above the cube, 45 degrees a waypoint, brought the tool frame to 41 mm of the
+                # centre and a fingertip onto the cube at 93 N, SAPIEN Rubiks-1-20 sensor-aided seed
+                # 0): the arc ends here, and the checked move (with its detours) takes the rest
+                self.ctx.recorder.event(
+                    "swing_cut",
+                    hand=hand.side,
+                    label=label,
+                    clearance_mm=round(
+                        1000 * self.sweep_clearance(hand, q_now, res.q[0], points), 1
+                    ),
+                )
+                break
+            self.send(
+                hand,
+                way,
+                label=f"{label} arc",
+                settle=0.02,
+                seed_q=None if points is None else res.q[0],
+            )
         self.transit(hand, far, label=label, seed_q=seed_q)
 
     def _ik_q(self, hand: Hand, pose: Pose, seed: np.ndarray) -> np.ndarray | None:
@@ -876,6 +898,12 @@ class BimanualRubiksMachine:
         step = 0.02
         approach = ref.rotation.apply(along(self.grasp.approach_axis, 1.0))
         dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
+        if points is not None and self.config.side_retreat > 0:
+            route = self._side_route(hand, ref, dist, d, points)
+            if route is not None:
+                for way, q, lab in route:
+                    self.send(hand, way, label=lab, settle=0.02, seed_q=q)
+                return
         while dist + step <= d + 1e-9:
             nxt = self.back_off(ref, dist + step)
             ok, q_next = way_out(nxt)
@@ -888,6 +916,127 @@ class BimanualRubiksMachine:
             message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
             f"(the straight way out leaves the arm's branch)",
         )
+
+    def _side_route(
+        self, hand: Hand, ref: Pose, dist: float, d: float, points: np.ndarray
+    ) -> list[tuple[Pose, np.ndarray, str]] | None:
+        """A retreat when the straight one fails: back along the approach from ``ref`` in 2 cm steps as
+        far as that goes (from ``dist``, towards ``d``), then sideways (the axis across the approach and
+        finger axes: the open pads slide along the faces they were on) in 2 cm steps until the hand is
+        ``sweep_clearance`` from the believed cube (at most ``side_retreat``), then back along the
+        approach again as far as it goes up to ``d``. Every step is solved from the last and must be
+        smooth (``max_waypoint_jump``) and clear (:meth:`_clears`). The sideways direction pointing
+        away from the other hand (if it holds the cube) is tried first; one pointing towards it (more
+        than 60 degrees from square) is not tried: the check sees the cube, not the other hand's
+        fingers. Returns the waypoints (pose, IK solution, label) or None; a ``retreat_side`` event is
+        recorded for a route found."""
+        step = 0.02
+        c = self.est.p
+        other = self.other(hand)
+        side_axis = 3 - self.grasp.approach_axis - self.grasp.finger_axis
+        lateral = ref.rotation.apply(along(side_axis, 1.0))
+        toward = other.cmd.p - c if other.holding else np.zeros(3)
+        toward = toward / max(float(np.linalg.norm(toward)), 1e-9)
+        dirs = sorted((s * lateral for s in (1.0, -1.0)), key=lambda v: float(np.dot(v, toward)))
+        dirs = [v for v in dirs if float(np.dot(v, toward)) <= 0.5]
+
+        q0 = hand.arm.positions()
+        n_back = max(0, math.floor((d - dist) / step + 1e-9))
+        first, _, _ = self._chain(
+            hand,
+            q0,
+            [self.back_off(ref, dist + step * (i + 1)) for i in range(n_back)],
+            "retreat step",
+            points,
+            True,
+        )
+        if len(first) == n_back:
+            return None  # the straight way out is clear in steps after all
+        # slide out from as far back as the straight way goes, else from nearer in
+        for k in range(len(first), -1, -1):
+            route = self._slide(hand, ref, first[:k], dirs, points, d - dist - step * k)
+            if route is not None:
+                side, last, v = route
+                self.ctx.recorder.event(
+                    "retreat_side",
+                    hand=hand.side,
+                    back_cm=round(100 * (dist + step * k)),
+                    side_cm=round(100 * step * len(side)),
+                    then_back_cm=round(100 * step * len(last)),
+                    direction=np.round(v, 2).tolist(),
+                )
+                return [*first[:k], *side, *last]
+        return None
+
+    def _chain(
+        self,
+        hand: Hand,
+        q: np.ndarray,
+        poses: list[Pose],
+        label: str,
+        points: np.ndarray,
+        stop_on_fail: bool,
+    ) -> tuple[list[tuple[Pose, np.ndarray, str]], np.ndarray, bool]:
+        """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``) and its joint
+        path clear (:meth:`_clears`): the waypoints (pose, IK solution, ``label``) that pass, the last
+        solution, and whether all passed (``stop_on_fail``: stop at the first that fails, else give up)."""
+        out: list[tuple[Pose, np.ndarray, str]] = []
+        for way in poses:
+            q1 = self._ik_q(hand, way, q)
+            if (
+                q1 is None
+                or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
+                or not self._clears(hand, q, q1, points)
+            ):
+                if stop_on_fail:
+                    break
+                return out, q, False
+            out.append((way, q1, label))
+            q = q1
+        return out, q, True
+
+    def _slide(
+        self,
+        hand: Hand,
+        ref: Pose,
+        first: list[tuple[Pose, np.ndarray, str]],
+        dirs: list[np.ndarray],
+        points: np.ndarray,
+        left: float,
+    ) -> tuple[list, list, np.ndarray] | None:
+        """From the end of ``first`` (or the hand's command): sideways along one of ``dirs`` in 2 cm steps
+        until ``sweep_clearance`` from the cube (at most ``side_retreat``), then back along the approach
+        as far as it goes, at most ``left`` (m): (sideways, back, direction) or None."""
+        cfg, step = self.config, 0.02
+        start = first[-1][0] if first else hand.cmd
+        q_start = first[-1][1] if first else hand.arm.positions()
+        for v in dirs:
+            side: list[tuple[Pose, np.ndarray, str]] = []
+            q, done = q_start, False
+            for i in range(1, math.floor(cfg.side_retreat / step + 1e-9) + 1):
+                part, q, ok = self._chain(
+                    hand, q, [Pose(start.p + v * step * i, start.q)], "retreat side", points, False
+                )
+                if not ok:
+                    break
+                side += part
+                if self.sweep_clearance(hand, q, q, points, n=1) >= cfg.sweep_clearance:
+                    done = True
+                    break
+            if not done:
+                continue
+            end = side[-1][0]
+            rest = max(0, math.floor(left / step + 1e-9))
+            ways = [
+                Pose(
+                    end.p - ref.rotation.apply(along(self.grasp.approach_axis, step * (i + 1))),
+                    end.q,
+                )
+                for i in range(rest)
+            ]
+            last, _, _ = self._chain(hand, q, ways, "retreat", points, True)
+            return side, last, v
+        return None
 
     def grip(
         self,
