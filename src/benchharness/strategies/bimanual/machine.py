@@ -693,7 +693,8 @@ class BimanualRubiksMachine:
         cube than ``sweep_clearance`` (or than it starts, if it starts nearer),
         the hand instead backs straight out along its approach in 2 cm steps to
         the first of ``detour_distances`` from which the swing to the stand-off's
-        orientation and the straight way back in (in 2 cm steps) stay clear, and
+        orientation and the straight way back in (in 2 cm steps) stay clear (where the
+        straight way out is not clear, the swing is checked from where the hand is), and
         a ``detour`` event is recorded. If none does, the direct move is made and
         a warning recorded.
         """
@@ -717,8 +718,12 @@ class BimanualRubiksMachine:
             turned = self.back_off(target, max(0.0, d - r1))
             leg_out = self._line(hand, hand.cmd, out, q0, points)
             if leg_out is None:
-                continue
-            qa = leg_out[-1][1]
+                # no straight way out (a joint limit on it): the joint-space turn to the stand-off's
+                # orientation from here, if that alone is clear (measured: a giver that had slid out
+                # sideways beside the cube, its shoulder pan and upper-arm roll on their soft limits,
+                # SAPIEN Rubiks-1-20 sensor-aided seed 0)
+                leg_out = []
+            qa = leg_out[-1][1] if leg_out else q0
             qb = self._ik_q(hand, turned, plan_seed)
             if qb is None or not self._clears(hand, qa, qb, points):
                 continue
@@ -731,6 +736,7 @@ class BimanualRubiksMachine:
                 label=label,
                 clearance_mm=round(1000 * clear, 1),
                 distance_m=d,
+                straight_out=bool(leg_out),
             )
             for way, q in leg_out:
                 self.send(hand, way, label=f"{label} detour out", settle=0.02, seed_q=q)
