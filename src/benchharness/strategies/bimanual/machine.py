@@ -489,7 +489,7 @@ class BimanualRubiksMachine:
         """The IK solution by which the arm reaches ``target`` from its joints without any joint moving
         more than ``max_waypoint_jump``, or None. Send the move seeded with it (``send(seed_q=...)``):
         solved again from the injected-error target, the arm can take another branch (measured: a
-        pre-touch sweep judged smooth swung the upper-arm and wrist rolls 3.1 rad, SAPIEN)."""
+        pre-touch sweep judged smooth swung the upper-arm and forearm rolls 3.1 rad, SAPIEN)."""
         base = hand.arm.base_pose()
         q = hand.arm.positions()
         res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
