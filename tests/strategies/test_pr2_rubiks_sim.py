@@ -81,17 +81,20 @@ def _run_cli(tmp_path, strategy: str, backend: str, task: str = "Rubiks-1-5"):
 #: 103.12 s, SAPIEN 93.37 / 98.43 s). Re-recorded for issue 15 item 1: a giver's alternative arm
 #: postures come from the planner's stream spawned once from the trial's rng, no longer from a
 #: generator seeded with the number of logged events (which a new diagnostic event changed; was
-#: PyBullet 90.73 / 95.94 s, SAPIEN 85.75 / 90.93 s).
+#: PyBullet 90.73 / 95.94 s, SAPIEN 85.75 / 90.93 s). Re-recorded for issue 16 (hand-over retreats): a
+#: free hand's swing-arc waypoints are now sent seeded with the IK solution their joint path was checked
+#: clear of the cube with (the arm then follows that solution, not one solved again from the
+#: injected-error target; was PyBullet 88.22 / 93.43 s, SAPIEN 84.88 / 90.06 s, digest bf826d40e7351660).
 REFERENCE_ROWS = {
     "pybullet": (
-        88.21666666666667,
-        93.425,
-        "88bc97f84f27afa7",
+        90.15833333333333,
+        95.36666666666666,
+        "cc20b1ff2a2729b8",
     ),
     "sapien": (
         84.87916666666666,
         90.0625,
-        "bf826d40e7351660",
+        "5e691da2717c5a9a",
     ),
 }
 

@@ -56,6 +56,14 @@ class BimanualConfig:
     #: stand-off would sweep the cube makes that move instead: straight back along its own approach to
     #: the distance, there to the stand-off's orientation (the joint-space swing), then straight in.
     detour_distances: tuple[float, ...] = (0.25, 0.35, 0.45)
+    #: a retreat whose straight way out fails (a joint limit, another branch beyond) may instead slide the
+    #: open hand sideways, across its approach and finger axes (the pads slide along the faces they
+    #: touched, away from the other hand), at most this far (m), after backing off as far as the straight
+    #: way allows (:meth:`.machine.BimanualRubiksMachine.release_hand`). 0: never. Why: a hand-over giver
+    #: above the cube with its shoulder lift on the soft limit could not rise at all (its first 2 cm step
+    #: swung the forearm roll 2.1 rad); its retreat was cut to 0 cm and the re-grip's move knocked the
+    #: cube (SAPIEN Rubiks-1-20 sensor-aided seed 0).
+    side_retreat: float = 0.10
     #: a free hand swings round the cube on an arc about its believed centre in Cartesian waypoints at most
     #: this many degrees apart (:meth:`.machine.BimanualRubiksMachine._swing`): one joint-space move from
     #: one side of the cube to another sweeps the hand along whatever path the joints take.

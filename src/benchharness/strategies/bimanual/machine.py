@@ -483,13 +483,21 @@ class BimanualRubiksMachine:
 
     def _smooth(self, hand: Hand, target: Pose) -> bool:
         """Whether the arm reaches ``target`` from its joints without any joint moving > max_waypoint_jump."""
+        return self.smooth_q(hand, target) is not None
+
+    def smooth_q(self, hand: Hand, target: Pose) -> np.ndarray | None:
+        """The IK solution by which the arm reaches ``target`` from its joints without any joint moving
+        more than ``max_waypoint_jump``, or None. Send the move seeded with it (``send(seed_q=...)``):
+        solved again from the injected-error target, the arm can take another branch (measured: a
+        pre-touch sweep judged smooth swung the upper-arm and forearm rolls 3.1 rad, SAPIEN)."""
         base = hand.arm.base_pose()
         q = hand.arm.positions()
         res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
-        return (
+        ok = (
             bool(res.success[0])
             and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
         )
+        return np.asarray(res.q[0], dtype=float) if ok else None
 
     def turn_travel(
         self,
@@ -508,27 +516,45 @@ class BimanualRubiksMachine:
         call per waypoint, each seeded with its own previous solution. The chain ends with the giver's
         retreat from the turned grip (``handover_retreat`` back along its approach): a turn that ends
         at a joint limit leaves no straight way out, and the arm's retreat then swings through the cube.
-        ``with_retreat=False``: the turn's waypoints only (a robot's fallback when no grip passes).
+        With the grasp module's ``hand_points`` the retreat is checked as :meth:`release_hand` makes
+        it: in 2 cm steps, each smooth and its joint path clear of the cube (:meth:`_clears`); a grip
+        whose retreat is not gets inf travel (its largest step stays that of its joints). Why:
+        checked as one IK step, a retreat that met the shoulder-lift limit half-way passed (0.68 rad)
+        while the executed retreat's 2 cm steps switched the upper-arm roll by 0.6 rad, swept the
+        open hand to 5 mm of the cube and were cut to 4 cm; the re-grip's stand-off move then found
+        no detour and knocked the cube out of the taker's hand (SAPIEN Rubiks-5-5 sensor-aided seed 0,
+        trial 5). ``with_retreat=False``: the turn's waypoints only (a robot's fallback when no grip
+        passes).
         """
         cfg = self.config
         n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
+        points = self._hand_points() if with_retreat else None
+        # (waypoint of the turn, of n; retreat distance) of each step
+        steps = [(i, 0.0) for i in range(1, n + 1)]
+        if with_retreat and points is None:
+            steps.append((n, cfg.handover_retreat))
+        elif with_retreat:
+            m = max(1, math.ceil(cfg.handover_retreat / 0.02 - 1e-9))
+            steps += [(n, cfg.handover_retreat * j / m) for j in range(1, m + 1)]
         q = np.array(q, dtype=float)
         total = np.zeros(len(grips))
         worst = np.zeros(len(grips))
-        for i in range(1, n + 2 if with_retreat else n + 1):
+        for i, back in steps:
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
-            poses = [
-                rotate_about_point(grips[k], self.est.p, axis, angle * min(i, n) / n) for k in live
-            ]
-            if i > n:  # the retreat
-                poses = [self.back_off(p, cfg.handover_retreat) for p in poses]
+            poses = [rotate_about_point(grips[k], self.est.p, axis, angle * i / n) for k in live]
+            if back > 0:  # the retreat
+                poses = [self.back_off(p, back) for p in poses]
             targets = [(base.inv() * p).as_matrix() for p in poses]
             res = hand.arm.ik(np.stack(targets), seed_q=q[live])
             jump = np.max(np.abs(res.q - q[live]), axis=1)
             reached = np.asarray(res.success, dtype=bool)
             bad = ~reached | (jump > cfg.max_waypoint_jump)
+            if back > 0 and points is not None:
+                for j, k in enumerate(live):
+                    if not bad[j] and np.isfinite(total[k]):
+                        bad[j] = not self._clears(hand, q[k], res.q[j], points)
             total[live] = np.where(bad, np.inf, total[live] + jump)
             worst[live] = np.where(reached, np.maximum(worst[live], jump), np.inf)
             q[live] = res.q
@@ -576,11 +602,33 @@ class BimanualRubiksMachine:
             self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
             return
         base = hand.arm.base_pose()
+        points = self._hand_points()
         for way in self._arc(c, [u0, u1], [hand.cmd.q, far.q], r0, r1):
-            if hand.arm.ik(
-                (base.inv() * way).as_matrix()[None], seed_q=hand.arm.positions()
-            ).success[0]:
-                self.send(hand, way, label=f"{label} arc", settle=0.02)
+            q_now = hand.arm.positions()
+            res = hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=q_now)
+            if not res.success[0]:
+                continue
+            if points is not None and not self._clears(hand, q_now, res.q[0], points):
+                # the joint path to the next waypoint sweeps the cube (measured: a giver's re-grip arc
+                # from above the cube, 45 degrees a waypoint, brought the tool frame to 41 mm of the
+                # centre and a fingertip onto the cube at 93 N, SAPIEN Rubiks-1-20 sensor-aided seed
+                # 0): the arc ends here, and the checked move (with its detours) takes the rest
+                self.ctx.recorder.event(
+                    "swing_cut",
+                    hand=hand.side,
+                    label=label,
+                    clearance_mm=round(
+                        1000 * self.sweep_clearance(hand, q_now, res.q[0], points), 1
+                    ),
+                )
+                break
+            self.send(
+                hand,
+                way,
+                label=f"{label} arc",
+                settle=0.02,
+                seed_q=None if points is None else res.q[0],
+            )
         self.transit(hand, far, label=label, seed_q=seed_q)
 
     def _ik_q(self, hand: Hand, pose: Pose, seed: np.ndarray) -> np.ndarray | None:
@@ -645,7 +693,8 @@ class BimanualRubiksMachine:
         cube than ``sweep_clearance`` (or than it starts, if it starts nearer),
         the hand instead backs straight out along its approach in 2 cm steps to
         the first of ``detour_distances`` from which the swing to the stand-off's
-        orientation and the straight way back in (in 2 cm steps) stay clear, and
+        orientation and the straight way back in (in 2 cm steps) stay clear (where the
+        straight way out is not clear, the swing is checked from where the hand is), and
         a ``detour`` event is recorded. If none does, the direct move is made and
         a warning recorded.
         """
@@ -669,8 +718,12 @@ class BimanualRubiksMachine:
             turned = self.back_off(target, max(0.0, d - r1))
             leg_out = self._line(hand, hand.cmd, out, q0, points)
             if leg_out is None:
-                continue
-            qa = leg_out[-1][1]
+                # no straight way out (a joint limit on it): the joint-space turn to the stand-off's
+                # orientation from here, if that alone is clear (measured: a giver that had slid out
+                # sideways beside the cube, its shoulder pan and upper-arm roll on their soft limits,
+                # SAPIEN Rubiks-1-20 sensor-aided seed 0)
+                leg_out = []
+            qa = leg_out[-1][1] if leg_out else q0
             qb = self._ik_q(hand, turned, plan_seed)
             if qb is None or not self._clears(hand, qa, qb, points):
                 continue
@@ -683,6 +736,7 @@ class BimanualRubiksMachine:
                 label=label,
                 clearance_mm=round(1000 * clear, 1),
                 distance_m=d,
+                straight_out=bool(leg_out),
             )
             for way, q in leg_out:
                 self.send(hand, way, label=f"{label} detour out", settle=0.02, seed_q=q)
@@ -850,6 +904,12 @@ class BimanualRubiksMachine:
         step = 0.02
         approach = ref.rotation.apply(along(self.grasp.approach_axis, 1.0))
         dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
+        if points is not None and self.config.side_retreat > 0:
+            route = self._side_route(hand, ref, dist, d, points)
+            if route is not None:
+                for way, q, lab in route:
+                    self.send(hand, way, label=lab, settle=0.02, seed_q=q)
+                return
         while dist + step <= d + 1e-9:
             nxt = self.back_off(ref, dist + step)
             ok, q_next = way_out(nxt)
@@ -857,11 +917,133 @@ class BimanualRubiksMachine:
                 break
             self.send(hand, nxt, label="retreat step", settle=0.02, seed_q=q_next)
             dist += step
-        self.ctx.recorder.event(
-            "warning",
-            message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
-            f"(the straight way out leaves the arm's branch)",
+        if dist < d - 1e-6:  # made in full in steps (one move was not smooth or clear): no warning
+            self.ctx.recorder.event(
+                "warning",
+                message=f"{hand.side}: retreat cut to {100 * dist:.0f} cm "
+                f"(the straight way out leaves the arm's branch)",
+            )
+
+    def _side_route(
+        self, hand: Hand, ref: Pose, dist: float, d: float, points: np.ndarray
+    ) -> list[tuple[Pose, np.ndarray, str]] | None:
+        """A retreat when the straight one fails: back along the approach from ``ref`` in 2 cm steps as
+        far as that goes (from ``dist``, towards ``d``), then sideways (the axis across the approach and
+        finger axes: the open pads slide along the faces they were on) in 2 cm steps until the hand is
+        ``sweep_clearance`` from the believed cube (at most ``side_retreat``), then back along the
+        approach again as far as it goes up to ``d``. Every step is solved from the last and must be
+        smooth (``max_waypoint_jump``) and clear (:meth:`_clears`). The sideways direction pointing
+        away from the other hand (if it holds the cube) is tried first; one pointing towards it (more
+        than 60 degrees from square) is not tried: the check sees the cube, not the other hand's
+        fingers. Returns the waypoints (pose, IK solution, label) or None; a ``retreat_side`` event is
+        recorded for a route found."""
+        step = 0.02
+        c = self.est.p
+        other = self.other(hand)
+        side_axis = 3 - self.grasp.approach_axis - self.grasp.finger_axis
+        lateral = ref.rotation.apply(along(side_axis, 1.0))
+        toward = other.cmd.p - c if other.holding else np.zeros(3)
+        toward = toward / max(float(np.linalg.norm(toward)), 1e-9)
+        dirs = sorted((s * lateral for s in (1.0, -1.0)), key=lambda v: float(np.dot(v, toward)))
+        dirs = [v for v in dirs if float(np.dot(v, toward)) <= 0.5]
+
+        q0 = hand.arm.positions()
+        n_back = max(0, math.floor((d - dist) / step + 1e-9))
+        first, _, _ = self._chain(
+            hand,
+            q0,
+            [self.back_off(ref, dist + step * (i + 1)) for i in range(n_back)],
+            "retreat step",
+            points,
+            True,
         )
+        if len(first) == n_back:
+            return None  # the straight way out is clear in steps after all
+        # slide out from as far back as the straight way goes, else from nearer in
+        for k in range(len(first), -1, -1):
+            route = self._slide(hand, ref, first[:k], dirs, points, d - dist - step * k)
+            if route is not None:
+                side, last, v = route
+                self.ctx.recorder.event(
+                    "retreat_side",
+                    hand=hand.side,
+                    back_cm=round(100 * (dist + step * k)),
+                    side_cm=round(100 * step * len(side)),
+                    then_back_cm=round(100 * step * len(last)),
+                    direction=np.round(v, 2).tolist(),
+                )
+                return [*first[:k], *side, *last]
+        return None
+
+    def _chain(
+        self,
+        hand: Hand,
+        q: np.ndarray,
+        poses: list[Pose],
+        label: str,
+        points: np.ndarray,
+        stop_on_fail: bool,
+    ) -> tuple[list[tuple[Pose, np.ndarray, str]], np.ndarray, bool]:
+        """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``) and its joint
+        path clear (:meth:`_clears`): the waypoints (pose, IK solution, ``label``) that pass, the last
+        solution, and whether all passed (``stop_on_fail``: stop at the first that fails, else give up)."""
+        out: list[tuple[Pose, np.ndarray, str]] = []
+        for way in poses:
+            q1 = self._ik_q(hand, way, q)
+            if (
+                q1 is None
+                or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
+                or not self._clears(hand, q, q1, points)
+            ):
+                if stop_on_fail:
+                    break
+                return out, q, False
+            out.append((way, q1, label))
+            q = q1
+        return out, q, True
+
+    def _slide(
+        self,
+        hand: Hand,
+        ref: Pose,
+        first: list[tuple[Pose, np.ndarray, str]],
+        dirs: list[np.ndarray],
+        points: np.ndarray,
+        left: float,
+    ) -> tuple[list, list, np.ndarray] | None:
+        """From the end of ``first`` (or the hand's command): sideways along one of ``dirs`` in 2 cm steps
+        until ``sweep_clearance`` from the cube (at most ``side_retreat``), then back along the approach
+        as far as it goes, at most ``left`` (m): (sideways, back, direction) or None."""
+        cfg, step = self.config, 0.02
+        start = first[-1][0] if first else hand.cmd
+        q_start = first[-1][1] if first else hand.arm.positions()
+        for v in dirs:
+            side: list[tuple[Pose, np.ndarray, str]] = []
+            q, done = q_start, False
+            for i in range(1, math.floor(cfg.side_retreat / step + 1e-9) + 1):
+                part, q, ok = self._chain(
+                    hand, q, [Pose(start.p + v * step * i, start.q)], "retreat side", points, False
+                )
+                if not ok:
+                    break
+                side += part
+                if self.sweep_clearance(hand, q, q, points, n=1) >= cfg.sweep_clearance:
+                    done = True
+                    break
+            if not done:
+                continue
+            end = side[-1][0]
+            rest = max(0, math.floor(left / step + 1e-9))
+            ways = [
+                Pose(
+                    end.p - ref.rotation.apply(along(self.grasp.approach_axis, step * (i + 1))),
+                    end.q,
+                )
+                for i in range(rest)
+            ]
+            last, _, _ = self._chain(hand, q, ways, "retreat", points, True)
+            return side, last, v
+        return None
 
     def grip(
         self,

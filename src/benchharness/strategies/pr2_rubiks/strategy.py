@@ -479,18 +479,30 @@ class PR2SensorAidedGrasp(PR2Grasp):
                     float(np.linalg.norm(tool_at(p, f).p - pre.p)) for p in (start, end)
                 ),
             )
-            finger = next((f for f in order if m._smooth(hand, tool_at(start, f))), None)
+            # each move is sent seeded with the IK solution it was judged smooth with: solved again
+            # from the injected-error target it can take another branch (measured, SAPIEN Rubiks-5-5
+            # sensor-aided seed 0 trial 4: a sweep judged smooth swung the upper-arm roll 3.1 rad, the
+            # palm hit the cube held by the other hand alone at 25 N and turned it 31 degrees)
+            finger, q_a = None, None
+            for f in order:
+                q_a = m.smooth_q(hand, tool_at(start, f))
+                if q_a is not None:
+                    finger = f
+                    break
             if finger is None:
                 skipped.append(name)
                 continue
             sensor, rng = sensors[finger]
             a_pose, b_pose = tool_at(start, finger), tool_at(end, finger)
             try:
-                m.send(hand, a_pose, label=f"{label} pre-touch {name} start", settle=0.05)
+                m.send(
+                    hand, a_pose, label=f"{label} pre-touch {name} start", settle=0.05, seed_q=q_a
+                )
             except StrategyFailure:  # the injected errors put the target just out of reach
                 skipped.append(name)
                 continue
-            if not m._smooth(hand, b_pose):
+            q_b = m.smooth_q(hand, b_pose)
+            if q_b is None:
                 skipped.append(name)
                 continue
             got: list[Any] = []
@@ -515,6 +527,7 @@ class PR2SensorAidedGrasp(PR2Grasp):
                     label=f"{label} pre-touch {name}",
                     duration=float(np.linalg.norm(end - start)) / sw.speed,
                     settle=0.0,
+                    seed_q=q_b,
                 )
             except StrategyFailure:  # as above: the sweep's end just out of reach; not used
                 got.clear()
