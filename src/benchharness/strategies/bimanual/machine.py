@@ -889,13 +889,12 @@ class BimanualRubiksMachine:
 
         def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
             """Smooth, and (with hand points) clear of the cube; the IK solution to seed the move with."""
-            if not self._smooth(hand, target):
+            q1 = self.smooth_q(hand, target)
+            if q1 is None:
                 return False, None
             if points is None:
                 return True, None
-            q0 = hand.arm.positions()
-            q1 = self._ik_q(hand, target, q0)
-            return (q1 is not None and self._clears(hand, q0, q1, points)), q1
+            return self._clears(hand, hand.arm.positions(), q1, points), q1
 
         ok, q_back = way_out(back)
         if ok:

@@ -382,17 +382,22 @@ class PR2SensorAidedGrasp(PR2Grasp):
         and is never part of a face for :func:`~benchharness.sensors.find_edges`, but still counts as
         beyond an edge when it is far behind the face (the holder's pad end 28 mm behind a side edge).
         """
-        from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, TCP_X, finger_boxes
+        from ...robots.descriptions.pr2 import (
+            FINGER_TRAVEL,
+            PAD_GAP,
+            PALM_BOX,
+            TCP_X,
+            finger_boxes,
+        )
         from ...sensors.raybox import ray_box
 
         if not self.config.pretouch_see_robot:
             return np.zeros(len(z), dtype=bool)
         other = m.other(hand)
         opening = 2 * CUBE_HALF if other.holding else 2 * (FINGER_TRAVEL + PAD_GAP)
-        boxes = [(np.array([0.08 - TCP_X, 0.0, 0.0]), np.array([0.03, 0.035, 0.025]))]
-        boxes += [
+        boxes = [
             (np.array(c) - [TCP_X, 0.0, 0.0], np.array(size) / 2)
-            for c, size in finger_boxes(opening)
+            for c, size in (PALM_BOX, *finger_boxes(opening))
         ]
         tool = other.cmd
         rot = tool.rotation.as_matrix()
