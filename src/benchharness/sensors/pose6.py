@@ -213,14 +213,13 @@ class CubePose6Filter:
         """At iterate ``xi``: measured, predicted, Jacobian, variance, usable (predicted) per row."""
         cfg = self.config
         pose = compose(self.nominal, xi)
-        n_r = len(z)
         returned = np.isfinite(z)
         hit, rng, jac_r, cos_inc, edge_d = range_model(pose, self.half, o, d)
         cos_max = math.cos(math.radians(cfg.max_incidence_deg))
         ok_r = returned & hit & (np.nan_to_num(edge_d) >= cfg.edge_margin) & (cos_inc >= cos_max)
         z_ok = np.where(returned, z, 0.0)
         var_r = (self.tof.noise_std + self.tof.noise_std_per_m * z_ok) ** 2
-        meas = [np.where(returned, z, 0.0)]
+        meas = [z_ok]
         pred = [np.where(ok_r, rng, 0.0)]
         jac = [np.where(ok_r[:, None], jac_r, 0.0)]
         var = [var_r]
@@ -239,7 +238,6 @@ class CubePose6Filter:
         jac.append(je)
         var.append(ve)
         ok.append(oke)
-        del n_r
         jac_all = np.concatenate(jac, axis=0).reshape(-1, _DIM)
         jac_all[:, 3:] = jac_all[:, 3:] @ left_jacobian(xi[3:])
         return (

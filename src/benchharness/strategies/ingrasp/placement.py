@@ -288,41 +288,32 @@ def place_object(
             and float(np.max(penetration(m2, vertices) - clearance, initial=0.0)) <= fit_tol
         )
 
-    # stage 2: the best few, with the hand's other parts kept out of the object
-    best: tuple | None = None
-    for _, _, _, x1, r0, _ in ranked[:refine]:
-        cost, x, m2 = refine_one(x1, r0)
-        key: tuple = (round(cost, 10), float(np.linalg.norm(x[3:])))
-        if best is None or key < best[0]:
-            best = (key, cost, x, r0, m2)
-    assert best is not None
-    if grip_cone_deg is not None and grip_excess(best[4]) > 0.0:
+    # stage 2: the best few, with the hand's other parts kept out of the object; the first of the
+    # least (cost, turn away from the candidate's axes)
+    def fit_key(e: tuple[float, np.ndarray, np.ndarray]) -> tuple:
+        return (round(e[0], 10), float(np.linalg.norm(e[1][3:])))
+
+    cost, x, m = min((refine_one(x1, r0) for _, _, _, x1, r0, _ in ranked[:refine]), key=fit_key)
+    if grip_cone_deg is not None and grip_excess(m) > 0.0:
         # the best fit does not grip: also refine the touching candidates that grip best
         # (penetration is only fixed in stage 2) and take the touching pose that grips best
         touching = [e for e in ranked if float(np.max(np.abs(gaps(e[5])))) <= fit_tol]
         touching.sort(key=lambda e: (round(grip_excess(e[5]), 6), e[0], e[1], e[2]))
-        pool = [(best[1], best[2], best[3], best[4])]
-        for _, _, _, x1, r0, _ in touching[: 2 * refine]:
-            cost, x, m2 = refine_one(x1, r0)
-            pool.append((cost, x, r0, m2))
-        for cost, x, r0, m2 in pool:
-            ok = fits(m2)
-            key = (
-                not ok,
-                round(grip_excess(m2), 6) if ok else 0.0,  # none fits: the best fit, as without
-                round(cost, 10),
-                float(np.linalg.norm(x[3:])),
-            )
-            if key < best[0] or len(best[0]) == 2:
-                best = (key, cost, x, r0, m2)
-    assert best is not None
-    m = pose_of(best[2], best[3])
+        pool = [(cost, x, m)]
+        pool += [refine_one(x1, r0) for _, _, _, x1, r0, _ in touching[: 2 * refine]]
+
+        def grip_key(e: tuple[float, np.ndarray, np.ndarray]) -> tuple:
+            ok = fits(e[2])
+            # none fits: the best fit, as without the cone
+            return (not ok, round(grip_excess(e[2]), 6) if ok else 0.0, *fit_key(e))
+
+        cost, x, m = min(pool, key=grip_key)
     return InGraspPlacement(
         m,
         gaps(m),
         float(np.max(penetration(m, vertices) - clearance, initial=0.0).clip(min=0.0)),
-        best[1],
-        float(np.degrees(np.linalg.norm(best[2][3:]))),
+        cost,
+        float(np.degrees(np.linalg.norm(x[3:]))),
         grip_angles(m),
     )
 
