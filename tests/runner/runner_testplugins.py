@@ -7,8 +7,10 @@ error, timeouts, declared failures) with known, deterministic numbers.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -203,6 +205,45 @@ class InhandNoisyStrategy:
         return TrialOutcome(reached=reached, plan_time_s=0.5, exec_time_s=1.67)
 
 
+@dataclass(frozen=True)
+class _Reach:
+    """A nested group, as the real strategies' ``errors`` and ``sweep``."""
+
+    #: m, a nested float
+    margin: float = 0.01
+    enabled: bool = True
+
+
+@dataclass(frozen=True)
+class ConfiguredConfig:
+    """Every field type ``--strategy-option`` reads."""
+
+    #: simulated steps held per move
+    hold_steps: int = 4
+    label: str = "plain"
+    scale: float = 1.0
+    depth: int | None = None
+    offsets: tuple[float, ...] = (0.25, 0.35)
+    pair: tuple[float, float] = (0.0, 1.0)
+    reach: _Reach = field(default_factory=_Reach)
+
+    def __post_init__(self) -> None:
+        if self.label not in ("plain", "fancy"):
+            raise ValueError(f"label must be 'plain' or 'fancy', not {self.label!r}")
+
+
+class ConfiguredStrategy(DropStrategy):
+    """Drops the cube as test-drop, and keeps the configuration it ran with in ``extra``."""
+
+    def __init__(self, config: ConfiguredConfig | None = None) -> None:
+        self.config = config or ConfiguredConfig()
+
+    def run_trial(self, ctx):
+        out = super().run_trial(ctx)
+        ctx.recorder.event("config", **dataclasses.asdict(self.config))
+        return out
+
+
 STRATEGIES = {
     "test-drop": DropStrategy,
     "test-wrong": WrongStateStrategy,
@@ -236,4 +277,11 @@ def benchharness_strategies():
     return [
         Registration(name, cls, f"test-only: {cls.__doc__ or name}".splitlines()[0])
         for name, cls in STRATEGIES.items()
+    ] + [
+        Registration(
+            "test-configured",
+            ConfiguredStrategy,
+            "test-only: keeps its --strategy-option configuration",
+            options=lambda: {"config": ConfiguredConfig()},
+        )
     ]

@@ -109,6 +109,14 @@ def run_options(f: Callable) -> Callable:
             help="In-hand: trials per task row.",
         ),
         click.option(
+            "--strategy-option",
+            "strategy_kv",
+            multiple=True,
+            metavar="KEY=VALUE",
+            help="A field of the strategy's config, repeatable: pretouch_mode=grid, "
+            "errors.tracking_std=0.002 (list them: benchharness plugins --options STRATEGY).",
+        ),
+        click.option(
             "--physics",
             "physics_kv",
             multiple=True,
@@ -165,9 +173,11 @@ def _spec(
     sim_budget,
     wall_budget,
     plugins,
+    strategy_kv=(),
 ):
     from ..plugin import PluginNotFoundError
     from ..runner.contract import TimeBudget
+    from ..runner.options import normalise_options
     from ..runner.plugins import check_strategy_robot, lookup
     from ..runner.spec import RunSpec, parse_physics
     from ..runner.tasks import plan_task
@@ -187,6 +197,10 @@ def _spec(
         item = lookup("task", task, tuple(plugins))
         plan = plan_task(item.name, item.create(), seed, repeats)
         check_strategy_robot(strategy, robot, tuple(plugins))
+        strategy_item = lookup("strategy", strategy, tuple(plugins))
+        options = normalise_options(
+            strategy_item.options, strategy_item.name, strategy_kv, strategy_item.factory
+        )
     except (PluginNotFoundError, TypeError, ValueError) as exc:
         fail(str(exc))
     if sim_budget is None:
@@ -206,6 +220,7 @@ def _spec(
         budget=TimeBudget(sim_budget, wall_budget),
         repeats=repeats,
         plugins=tuple(plugins),
+        strategy_options=options,
     )
 
 
@@ -421,6 +436,7 @@ def run(
     workers,
     trial_sel,
     repeats,
+    strategy_kv,
     physics_kv,
     sim_budget,
     wall_budget,
@@ -447,6 +463,7 @@ def run(
       benchharness run --task Rubiks-5-20 --robot pr2 --strategy sensor-aided --backend pybullet --seed 0
       benchharness run --task inhand-level1 --robot allegro --strategy relaxed-rigidity --repeats 5
       benchharness run --task Rubiks-1-5 --robot pr2 --strategy dead-reckoning --video trial1.mp4
+      benchharness run --task Rubiks-5-5 --robot pr2 --strategy sensor-aided --strategy-option pretouch_mode=grid
     """
     spec = _spec(
         task,
@@ -460,6 +477,7 @@ def run(
         sim_budget,
         wall_budget,
         plugins,
+        strategy_kv,
     )
     video = None
     if video_path is not None:
@@ -750,6 +768,7 @@ def compare(
     workers,
     trial_sel,
     repeats,
+    strategy_kv,
     physics_kv,
     sim_budget,
     wall_budget,
@@ -795,6 +814,7 @@ def compare(
                 sim_budget,
                 wall_budget,
                 plugins,
+                strategy_kv,
             )
             report = _sweep(spec, store, workers, trial_sel, retry_failed, progress)
             benchmark = report.plan.benchmark

@@ -44,6 +44,14 @@ def _ints(text: str, option: str) -> tuple[int, ...]:
     metavar="K=V,K=V",
     help="One physics setting set (comma list of KEY=VALUE); repeat for more grid points.",
 )
+@click.option(
+    "--strategy-option",
+    "strategy_kv",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="A strategy config field for every strategy of the grid, repeatable (per strategy: "
+    "[strategy_options.NAME] in the grid file).",
+)
 @click.option("--sensors", default=None, help="Comma list of sensors, for every run.")
 @click.option("--repeats", type=int, default=None, help="In-hand: trials per task row (default 1).")
 @click.option("--sim-budget", type=float, default=None, help="Simulated seconds per trial.")
@@ -86,6 +94,7 @@ def sweep(
     backends,
     seeds,
     physics_sets,
+    strategy_kv,
     sensors,
     repeats,
     sim_budget,
@@ -135,6 +144,10 @@ def sweep(
         base["sensors"] = _names(sensors)
     if plugins:
         base["plugins"] = tuple(base.get("plugins", ())) + tuple(plugins)
+    if strategy_kv:
+        base["strategy_options"] = tuple(base.get("strategy_options", ())) + (
+            ("*", tuple(strategy_kv)),
+        )
     for name, value in (
         ("repeats", repeats),
         ("sim_budget", sim_budget),

@@ -81,6 +81,8 @@ class Item:
     meta_source: Mapping[str, Any] | Callable[[], Mapping[str, Any]] = field(
         default_factory=dict, repr=False
     )
+    #: the registration's ``options`` (strategies): factory keyword -> default config dataclass
+    options: Callable[[], Mapping[str, Any]] | None = field(default=None, repr=False)
 
     @cached_property
     def meta(self) -> dict[str, Any]:
@@ -296,7 +298,9 @@ class PluginManager:
                 )
             )
             return
-        self._items[key] = Item(kind, reg.name, reg.factory, reg.summary, dist, label, reg.meta)
+        self._items[key] = Item(
+            kind, reg.name, reg.factory, reg.summary, dist, label, reg.meta, reg.options
+        )
 
     # -- queries -----------------------------------------------------------
     def items(self, kind: str | None = None) -> list[Item]:

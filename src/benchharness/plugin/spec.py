@@ -66,12 +66,18 @@ class Registration:
     backend's capability flags or a robot's DOF), or a function returning
     them, called the first time they are read: a robot's DOF and groups come
     from its config, and building configs need not slow every command down.
+    ``options`` (strategies) returns the factory's configuration keywords
+    with their default dataclass instances, e.g. ``{"config": MyConfig()}``:
+    what ``--strategy-option KEY=VALUE`` may set (see
+    :mod:`benchharness.runner.options`); the factory is then called with
+    those keywords. Called only when options are given or listed.
     """
 
     name: str
     factory: Callable[..., Any]
     summary: str = ""
     meta: Mapping[str, Any] | Callable[[], Mapping[str, Any]] = field(default_factory=dict)
+    options: Callable[[], Mapping[str, Any]] | None = None
 
 
 class BenchharnessSpec:

@@ -43,6 +43,9 @@ class Grid:
     sim_budget: float | None = None
     wall_budget: float | None = None
     plugins: tuple[str, ...] = ()
+    #: ``--strategy-option`` settings (``KEY=VALUE``) per strategy name; ``"*"`` applies to every
+    #: strategy of the grid (the command line's, which come last). For one key, the later wins.
+    strategy_options: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
 
 @dataclass
@@ -64,7 +67,9 @@ def load_grid(path: Path) -> Grid:
     """A grid from TOML: top-level keys named like :class:`Grid`'s fields (lists or single values).
 
     ``physics`` is a list of tables (``[[physics]]`` or ``physics = [{timestep = "1/500"}]``),
-    each one setting set; values as on the command line.
+    each one setting set; values as on the command line. ``[strategy_options.NAME]`` tables
+    hold one strategy's ``--strategy-option`` settings (``pretouch_mode = "grid"``; a list is
+    a comma list).
     """
     if sys.version_info >= (3, 11):
         import tomllib
@@ -95,6 +100,16 @@ def load_grid(path: Path) -> Grid:
         if not all(isinstance(s, dict) for s in sets):
             raise ValueError(f"{path}: physics must be a list of tables of settings")
         kw["physics"] = tuple(tuple(f"{k}={v}" for k, v in s.items()) for s in sets) or ((),)
+    if "strategy_options" in data:
+        table = data["strategy_options"]
+        if not isinstance(table, dict) or not all(isinstance(v, dict) for v in table.values()):
+            raise ValueError(
+                f"{path}: strategy_options must be tables [strategy_options.STRATEGY] of settings"
+            )
+        kw["strategy_options"] = tuple(
+            (name, tuple(f"{k}={_toml_text(v)}" for k, v in opts.items()))
+            for name, opts in table.items()
+        )
     for name, kind in (("repeats", int), ("sim_budget", float), ("wall_budget", float)):
         if name in data:
             v = data[name]
@@ -102,6 +117,31 @@ def load_grid(path: Path) -> Grid:
                 raise ValueError(f"grid {name}: {v!r} is not a number")
             kw[name] = kind(v)
     return Grid(**kw)
+
+
+def _toml_text(value: Any) -> str:
+    """A TOML value as the command line would spell it (``true``, ``0.25,0.35``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list):
+        return ",".join(_toml_text(v) for v in value)
+    return str(value)
+
+
+def _strategy_options(grid: Grid, item: Any) -> tuple[tuple[str, str], ...]:
+    """The canonical options of one strategy of the grid (ValueError naming strategy and key)."""
+    from .options import normalise_options
+
+    pairs: list[str] = []
+    for name, opts in grid.strategy_options:
+        if name in ("*", item.name):
+            pairs += list(opts)
+    # for one key the later entry wins (the command line's "*" entries come after the file's)
+    merged = {p.split("=", 1)[0].strip().replace("-", "_"): p for p in pairs}
+    try:
+        return normalise_options(item.options, item.name, list(merged.values()), item.factory)
+    except ValueError as exc:
+        raise ValueError(f"strategy {item.name}: {exc}") from None
 
 
 def expand(grid: Grid) -> GridPlan:
@@ -139,6 +179,10 @@ def expand(grid: Grid) -> GridPlan:
             for n in names:
                 lookup(kind, n, plugins)
         strategies = {s: lookup("strategy", s, plugins) for s in grid.strategies}
+        for name, _ in grid.strategy_options:
+            if name != "*" and name not in strategies:
+                raise ValueError(f"strategy_options: {name!r} is not a strategy of this grid")
+        options = {s: _strategy_options(grid, item) for s, item in strategies.items()}
         plans = {}
         for t in grid.tasks:
             item = lookup("task", t, plugins)
@@ -192,6 +236,7 @@ def expand(grid: Grid) -> GridPlan:
                 budget=TimeBudget(sim, grid.wall_budget),
                 repeats=grid.repeats,
                 plugins=plugins,
+                strategy_options=options[strategy],
             )
         )
     for axis in ("strategies", "robots", "tasks"):

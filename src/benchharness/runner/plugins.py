@@ -17,7 +17,7 @@ from typing import Any
 from ..plugin import Item, PluginManager, PluginNotFoundError, get_manager
 from .contract import check_drives
 
-__all__ = ["manager_for", "lookup", "create_item", "check_strategy_robot"]
+__all__ = ["manager_for", "lookup", "create_item", "create_strategy", "check_strategy_robot"]
 
 
 @lru_cache(maxsize=8)
@@ -51,6 +51,23 @@ def lookup(kind: str, name: str, plugins: tuple[str, ...] = ()) -> Item:
 
 def create_item(kind: str, name: str, plugins: tuple[str, ...] = (), **kwargs: Any) -> Any:
     return lookup(kind, name, plugins).create(**kwargs)
+
+
+def create_strategy(spec: Any) -> Any:
+    """The run's strategy, its factory given the run's ``--strategy-option`` settings.
+
+    ``spec`` is a :class:`~.spec.RunSpec`. Without options the factory is
+    called bare, exactly as before options existed.
+    """
+    item = lookup("strategy", spec.strategy, spec.plugins)
+    if not spec.strategy_options:
+        return item.create()
+    from .options import apply_options
+
+    if item.options is None:
+        raise ValueError(f"strategy {spec.strategy!r} declares no options")
+    kwargs, _ = apply_options(item.options(), spec.strategy_options)
+    return item.create(**kwargs)
 
 
 def check_strategy_robot(strategy: str, robot: str, plugins: tuple[str, ...] = ()) -> None:

@@ -126,7 +126,10 @@ class RunSpec:
     ``repeats`` applies to in-hand task sets (trials per task row; Rubik's
     tiers have their own M). ``plugins`` names extra plugin modules to
     register in every process (see ``--plugin``); they are not part of the
-    key, the item names they provide are.
+    key, the item names they provide are. ``strategy_options`` are the
+    ``--strategy-option`` settings in canonical form (sorted ``(key, value)``
+    pairs, :func:`benchharness.runner.options.normalise_options`); they are
+    part of the options hash, which is unchanged when there are none.
     """
 
     task: str
@@ -140,6 +143,7 @@ class RunSpec:
     repeats: int = 1
     plugins: tuple[str, ...] = ()
     code: str = field(default_factory=code_version)
+    strategy_options: tuple[tuple[str, str], ...] = ()
 
     @property
     def sensors_label(self) -> str:
@@ -151,7 +155,10 @@ class RunSpec:
 
     @property
     def options_hash(self) -> str:
-        return stable_hash({"budget": asdict(self.budget), "repeats": self.repeats}, 12)
+        data: dict[str, Any] = {"budget": asdict(self.budget), "repeats": self.repeats}
+        if self.strategy_options:
+            data["strategy_options"] = [list(p) for p in self.strategy_options]
+        return stable_hash(data, 12)
 
     def key_fields(self) -> dict[str, Any]:
         return {
@@ -180,6 +187,7 @@ class RunSpec:
             budget=asdict(self.budget),
             repeats=self.repeats,
             plugins=list(self.plugins),
+            strategy_options=dict(self.strategy_options),
             run_key=self.run_key,
         )
         return d

@@ -21,7 +21,7 @@ from typing import Any
 from ..backends.interface import SimulationError
 from .causes import FailureCause, TrialStatus
 from .contract import SensorSlot, TrialContext, TrialOutcome, TrialTimeout
-from .plugins import create_item, lookup
+from .plugins import create_item, create_strategy, lookup
 from .recorder import TrialRecorder
 from .records import TrialRecord
 from .scoring import Verdict, score_inhand, score_rubiks
@@ -117,7 +117,7 @@ def execute_trial(
         for name, rng in zip(spec.sensors, streams.sensors):
             sensor = lookup("sensor", name, spec.plugins)
             sensors[name] = SensorSlot(name, rng, sensor.factory, dict(sensor.meta))
-        strategy = create_item("strategy", spec.strategy, spec.plugins)
+        strategy = create_strategy(spec)
         check_strategy_supports(strategy, plan.benchmark, spec.strategy)
         recorder = TrialRecorder(clock=lambda: float(backend.time))
         ctx = TrialContext(

@@ -28,12 +28,24 @@ def make_push_grasp(config=None):
     return PushGraspStrategy(config)
 
 
-def make_push_grasp_exact():
+def make_push_grasp_exact(config=None):
     """Strategy factory: push-grasp with every injected error zero."""
-    from .config import HerbPushGraspConfig
     from .strategy import PushGraspStrategy
 
-    return PushGraspStrategy(HerbPushGraspConfig().zero_error())
+    return PushGraspStrategy(config or _exact_options()["config"])
+
+
+def _options():
+    """``--strategy-option`` defaults: :class:`.config.HerbPushGraspConfig`."""
+    from .config import HerbPushGraspConfig
+
+    return {"config": HerbPushGraspConfig()}
+
+
+def _exact_options():
+    from .config import HerbPushGraspConfig
+
+    return {"config": HerbPushGraspConfig().zero_error()}
 
 
 REGISTRATIONS = [
@@ -42,11 +54,13 @@ REGISTRATIONS = [
         make_push_grasp,
         "HERB Rubik's strategy: every grasp a BarrettHand push-grasp (thumb stop, outer fingers close)",
         {"benchmarks": ["rubiks"], "robots": ["herb"]},
+        options=_options,
     ),
     Registration(
         "push-grasp-exact",
         make_push_grasp_exact,
         "HERB push-grasp with zero injected error (diagnostic)",
         {"benchmarks": ["rubiks"], "robots": ["herb"]},
+        options=_exact_options,
     ),
 ]

@@ -47,12 +47,22 @@ def _factory(variant: str):
     return factory
 
 
+def _options():
+    """``--strategy-option`` defaults: the planner's :class:`.config.IngraspConfig` (every variant
+    reads the same one) and the execution's :class:`.execution.ExecConfig` as ``exec_config``."""
+    from .config import IngraspConfig
+    from .execution import ExecConfig
+
+    return {"config": IngraspConfig(), "exec_config": ExecConfig()}
+
+
 REGISTRATIONS = [
     Registration(
         name,
         _factory(name),
         summary,
         {"levels": [1], "robots": ["allegro"], "variant": name},
+        options=_options,
     )
     for name, summary in _SUMMARIES.items()
 ]

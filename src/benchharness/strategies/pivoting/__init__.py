@@ -27,6 +27,13 @@ def make_pivoting(**kwargs):
     return PivotingStrategy(**kwargs)
 
 
+def _options():
+    """``--strategy-option`` defaults: :class:`.config.PivotConfig` (grip, set-up, hold, motion ...)."""
+    from .config import PivotConfig
+
+    return {"config": PivotConfig()}
+
+
 REGISTRATIONS = [
     Registration(
         "pivoting",
@@ -38,5 +45,6 @@ REGISTRATIONS = [
             "benchmarks": ["inhand"],
             "robots": ["pr2-gripper"],
         },
+        options=_options,
     )
 ]

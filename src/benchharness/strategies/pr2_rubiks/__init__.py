@@ -29,12 +29,11 @@ def make_dead_reckoning(config=None):
     return DeadReckoningStrategy(config)
 
 
-def make_dead_reckoning_exact():
+def make_dead_reckoning_exact(config=None):
     """Strategy factory: dead reckoning with every injected error zero."""
-    from .config import PR2RubiksConfig
     from .strategy import DeadReckoningStrategy
 
-    return DeadReckoningStrategy(PR2RubiksConfig().zero_error())
+    return DeadReckoningStrategy(config or _exact_options()["config"])
 
 
 def make_sensor_aided(config=None):
@@ -44,23 +43,39 @@ def make_sensor_aided(config=None):
     return SensorAidedStrategy(config)
 
 
+def _options():
+    """``--strategy-option`` defaults: the PR2 baselines' one config (:class:`.config.PR2RubiksConfig`)."""
+    from .config import PR2RubiksConfig
+
+    return {"config": PR2RubiksConfig()}
+
+
+def _exact_options():
+    from .config import PR2RubiksConfig
+
+    return {"config": PR2RubiksConfig().zero_error()}
+
+
 REGISTRATIONS = [
     Registration(
         "dead-reckoning",
         make_dead_reckoning,
         "PR2 Rubik's baseline: head-camera estimate, then dead reckoning through regrasps",
         {"benchmarks": ["rubiks"], "robots": ["pr2"]},
+        options=_options,
     ),
     Registration(
         "dead-reckoning-exact",
         make_dead_reckoning_exact,
         "PR2 Rubik's dead reckoning with zero injected error (diagnostic)",
         {"benchmarks": ["rubiks"], "robots": ["pr2"]},
+        options=_exact_options,
     ),
     Registration(
         "sensor-aided",
         make_sensor_aided,
         "PR2 Rubik's baseline with pre-touch ToF re-localisation (EKF) before every grasp",
         {"benchmarks": ["rubiks"], "robots": ["pr2"], "sensors": ["pretouch-tof"]},
+        options=_options,
     ),
 ]
