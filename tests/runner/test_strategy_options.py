@@ -232,3 +232,26 @@ def test_sweep_file_options_per_strategy(tmp_path):
     )
     with pytest.raises(ValueError, match="strategy sensor-aided: --strategy-option swing_routes=3"):
         expand(load_grid(bad))
+
+
+def test_tables_show_an_option_run_as_its_own_method_across_tiers(tmp_path):
+    """Budgets differ per tier (so do options hashes): one column per option set, labelled by it."""
+    from benchharness.runner.reports import _columns
+    from benchharness.runner.store import ResultsStore
+
+    store = tmp_path / "s.sqlite"
+    runner = CliRunner()
+    for task in ("Rubiks-1-5", "Rubiks-1-10"):
+        for opts in ([], ["--strategy-option", "scale=0.5"]):
+            args = ["run", "--task", task, "--strategy", "test-configured", *BASE, *opts]
+            r = runner.invoke(cli, [*args, "--store", str(store)], catch_exceptions=False)
+            assert r.exit_code == 0, r.output
+    with ResultsStore(store, read_only=True) as s:
+        trials = s.trials()
+    cols, _ = _columns(trials)
+    assert sorted(c.label for c in cols) == [
+        "test-configured (test-stub, pybullet)",
+        "test-configured [scale=0.5] (test-stub, pybullet)",
+    ]
+    r = runner.invoke(cli, ["table", "--benchmark", "rubiks", "--store", str(store)])
+    assert r.exit_code == 0 and "[scale=0.5]" in r.output.replace("\n", ""), r.output

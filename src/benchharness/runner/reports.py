@@ -90,20 +90,25 @@ def _columns(trials: Iterable[StoredTrial]) -> tuple[list[Column], dict[str, Col
     def method_key(t: StoredTrial) -> tuple:
         return (t.robot, t.strategy, t.sensors, t.backend, t.seed, t.physics_hash)
 
+    def opt_key(t: StoredTrial) -> tuple:
+        # strategy options make another method whatever the budgets (the label names them)
+        return (method_key(t), t.strategy_options)
+
     per_task: dict[tuple, set[tuple[str, str]]] = {}
     for t in trials:
-        per_task.setdefault((method_key(t), t.task), set()).add((t.options_hash, t.code_version))
+        per_task.setdefault((opt_key(t), t.task), set()).add((t.options_hash, t.code_version))
     split_opt = {mk for (mk, _), s in per_task.items() if len({o for o, _ in s}) > 1}
     split_code = {mk for (mk, _), s in per_task.items() if len({c for _, c in s}) > 1}
     raw: dict[tuple, StoredTrial] = {}
     codes: dict[tuple, list[str]] = {}
     by_run: dict[str, tuple] = {}
     for t in trials:
-        mk = method_key(t)
+        mk = opt_key(t)
         k = (
-            *mk,
+            *mk[0],
             t.options_hash if mk in split_opt else "",
             t.code_version if mk in split_code else "",
+            t.strategy_options,
         )
         raw.setdefault(k, t)
         if t.code_version not in codes.setdefault(k, []):

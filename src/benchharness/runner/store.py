@@ -339,12 +339,15 @@ class StoredTrial:
     diagnostics: dict
     traceback: str
     finished_at: float
+    #: the run's ``--strategy-option`` settings, ``key=value`` comma-joined ("" for none)
+    strategy_options: str = ""
 
     @property
     def method(self) -> str:
-        """How a run is named in tables: strategy, robot, sensors, backend."""
+        """How a run is named in tables: strategy (and its options), robot, sensors, backend."""
         sensors = f"+{self.sensors}" if self.sensors else ""
-        return f"{self.strategy}{sensors} ({self.robot}, {self.backend})"
+        opts = f" [{self.strategy_options}]" if self.strategy_options else ""
+        return f"{self.strategy}{sensors}{opts} ({self.robot}, {self.backend})"
 
     def comparable(self) -> dict[str, Any]:
         return {
@@ -614,7 +617,10 @@ class ResultsStore:
             else:
                 where.append(f"t.{col} IN ({','.join('?' * len(vals))})")
             args.extend(vals)
-        sql = "SELECT t.* FROM trials t JOIN runs r ON r.run_key = t.run_key"
+        sql = (
+            "SELECT t.*, r.spec_json AS run_spec_json FROM trials t"
+            " JOIN runs r ON r.run_key = t.run_key"
+        )
         if where:
             sql += " WHERE " + " AND ".join(where)
         sql += " ORDER BY r.created_at, r.run_key, t.trial_index"
@@ -657,7 +663,19 @@ class ResultsStore:
             diagnostics=json.loads(r["diagnostics_json"]),
             traceback=r["traceback"],
             finished_at=r["finished_at"],
+            strategy_options=_options_text(r),
         )
+
+
+def _options_text(r: sqlite3.Row) -> str:
+    """A row's run's strategy options from its spec JSON, ``key=value`` comma-joined."""
+    if "run_spec_json" not in r.keys():
+        return ""
+    try:
+        opts = json.loads(r["run_spec_json"]).get("strategy_options") or {}
+    except (TypeError, ValueError, AttributeError):
+        return ""
+    return ",".join(f"{k}={v}" for k, v in sorted(opts.items()))
 
 
 def group_by_run(trials: Iterable[StoredTrial]) -> Iterator[tuple[str, list[StoredTrial]]]:
