@@ -257,25 +257,16 @@ def test_numpy_dls_matches_pytorch_kinematics_solver(robots, robot, chain):
     """
     import torch as _t
 
-    from benchharness.robots.kinematics import DTYPE
-
     arm = robots[robot].arm(chain)
     ch = arm.chain
     cfg = arm.robot.ik_config
     targets = ch.fk(ch.sample(20, _t.Generator().manual_seed(31)))
     init = ch.sample(20 * 3, _t.Generator().manual_seed(32)).reshape(20, 3, ch.dof)
     q_np, _, _, c_np = ch._dls(targets, init, cfg, cfg.max_iterations, stop_when_any=False)
-    q_pk, _, c_pk = ch._pk_solve(
-        _t.as_tensor(targets, dtype=DTYPE),
-        _t.as_tensor(init, dtype=DTYPE),
-        cfg,
-        cfg.max_iterations,
-        False,
-    )
-    c_pk = c_pk.numpy()
+    q_pk, _, c_pk = ch._pk_solve(targets, init, cfg, cfg.max_iterations, False)
     both = c_np & c_pk
     assert (c_np == c_pk).mean() >= 0.95 and both.sum() >= 10  # random restarts: ~40 % converge
-    diff = np.abs(q_np[both] - q_pk.numpy()[both]).max(axis=1)
+    diff = np.abs(q_np[both] - q_pk[both]).max(axis=1)
     # a redundant arm's solutions form a continuum: a restart that crosses the tolerance one iteration
     # apart (rounding) ends on a nearby point of it, so a few may differ by mrad
     assert (diff < 1e-6).mean() >= 0.9 and diff.max() < 2e-2

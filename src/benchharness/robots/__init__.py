@@ -5,10 +5,11 @@ A :class:`Robot` is composed from a :class:`RobotConfig` — arms
 (:class:`Gripper`, coupled finger joints). The built-in ``pr2``, ``herb``
 and ``allegro`` are registered as plugins in ``benchharness_builtins.robots``.
 
-The configs are plain data and import light; the parts and the robot import
-torch (pytorch-kinematics) and are loaded on first use of their names here, so
-that reading a config (``benchharness robots`` lists DOF and groups from the
-configs) does not load torch.
+The configs are plain data and import light; the parts and the robot (NumPy
+kinematics, the backends' interface) are loaded on first use of their names
+here, so that reading a config (``benchharness robots`` lists DOF and groups
+from the configs) stays cheap. Neither imports torch: pytorch-kinematics is
+loaded only for large IK/FK batches and whole-tree FK (:mod:`.kinematics`).
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ from ..geometry import Pose
 from ..paths import robots_dir
 from .config import ArmConfig, GripperConfig, RobotConfig
 
-if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+if TYPE_CHECKING:  # the robot loads with the robot, not with its config (robot_meta reads configs)
     from .robot import Robot
 
 __all__ = ["allegro_config", "make_allegro", "FINGERS"]

@@ -11,7 +11,7 @@ from ..paths import robots_dir
 from .config import ArmConfig, GripperConfig, RobotConfig, gains_from_effort
 from .descriptions.herb import BH_COUPLING, BH_PROX, WAM_EFFORT
 
-if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+if TYPE_CHECKING:  # the robot loads with the robot, not with its config (robot_meta reads configs)
     from .robot import Robot
 
 __all__ = ["herb_config", "make_herb", "BARRETT_HAND_COUPLING"]

@@ -1,9 +1,9 @@
-"""Kinematics from URDF text with pytorch-kinematics: batched FK, Jacobians, IK.
+"""Kinematics from URDF text: batched FK, Jacobians, IK (NumPy, with pytorch-kinematics for large batches).
 
-Everything here is CPU torch in float64 (millimetre tolerances over a metre
-of arm leave float32 little headroom) and deterministic: random IK restarts
-come from a :class:`torch.Generator` the caller passes or seeds explicitly,
-never from global random state.
+Everything is float64 (millimetre tolerances over a metre of arm leave
+float32 little headroom) and deterministic: random IK restarts come from a
+generator the caller passes (a :class:`~.uniform_stream.UniformStream`, or a
+``torch.Generator``) or seeds explicitly, never from global random state.
 
 Frames: a :class:`KinematicChain` works in its ``root_link`` frame. Callers
 that need world poses compose with the root link's world pose (from the
@@ -11,15 +11,21 @@ backend, or from :class:`KinematicTree`).
 
 Speed: pytorch-kinematics costs ~2 ms per solver iteration for a few
 targets (dozens of small torch ops per FK), so a motion's single IK call
-from the current configuration used to take ~200-300 ms. The chain's own
-pytorch-kinematics model (static frame offsets, axes, joint types) is
-therefore also evaluated in NumPy (:class:`_SerialModel`, checked against
-pytorch-kinematics FK when the chain is built; ~0.1 ms per FK + Jacobian):
-small FK/Jacobian batches, the seeded attempt (seed alone, early stopping)
-and IK passes of up to 256 rows run the same damped-least-squares iteration
-in NumPy (:meth:`KinematicChain._dls`, tested against ``PseudoInverseIK``);
-large batches (e.g. 1,000 targets x 4 restarts) stay on pytorch-kinematics'
-batched solver. A seeded call now costs a few ms.
+from the current configuration used to take ~200-300 ms. Each chain is
+therefore also a NumPy model (:class:`_SerialModel`, ~0.1 ms per FK +
+Jacobian): small FK/Jacobian batches, the seeded attempt (seed alone, early
+stopping) and IK passes of up to 256 rows run the same damped-least-squares
+iteration in NumPy (:meth:`KinematicChain._dls`, tested against
+``PseudoInverseIK``); large batches (e.g. 1,000 targets x 4 restarts) go to
+pytorch-kinematics' batched solver.
+
+Start-up: the NumPy model is read from the URDF as pytorch-kinematics reads
+it (:mod:`.urdf_chain`, equal to it bit for bit on the shipped robots) and
+the restarts are drawn from torch's generator stream reproduced in NumPy
+(:mod:`.uniform_stream`), so torch and pytorch-kinematics are imported only
+when a large batch, :class:`KinematicTree` or a ``torch.Generator`` needs
+them — never in a Rubik's trial, which saves each run command ~2.5 CPU-s
+(issue 12).
 """
 
 from __future__ import annotations
@@ -28,21 +34,55 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import torch
 
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore")
-    import pytorch_kinematics as pk
+from .uniform_stream import UniformStream
+from .urdf_chain import read_serial_chain
 
-__all__ = ["IKConfig", "IKResult", "KinematicChain", "KinematicTree", "pose_error"]
+if TYPE_CHECKING:
+    import torch
 
-DTYPE = torch.float64
+__all__ = [
+    "IKConfig",
+    "IKResult",
+    "KinematicChain",
+    "KinematicTree",
+    "UniformStream",
+    "pose_error",
+]
+
 _NUMPY_FK_MAX_BATCH = 32  #: above this, pytorch-kinematics' batched FK is as fast as the NumPy loop
 #: IK passes with at most this many rows (targets x restarts) run in NumPy (:meth:`KinematicChain._dls`),
 #: larger ones through pytorch-kinematics' batched solver
 _NUMPY_IK_MAX_ROWS = 256
+
+
+def __getattr__(name: str) -> Any:
+    """``DTYPE`` (torch.float64) on first use, so that importing this module does not import torch."""
+    if name == "DTYPE":
+        import torch
+
+        return torch.float64
+    raise AttributeError(name)
+
+
+def _pk() -> Any:
+    """pytorch-kinematics (and torch), imported on first need."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import pytorch_kinematics as pk
+    return pk
+
+
+def _uniform(generator: Any, n: int, dof: int) -> np.ndarray:
+    """``n`` x ``dof`` uniforms from a :class:`UniformStream` or a ``torch.Generator``."""
+    if isinstance(generator, UniformStream):
+        return generator.rand(n, dof)
+    import torch
+
+    return torch.rand(n, dof, generator=generator, dtype=torch.float64).numpy()
 
 
 def _read(urdf: str | Path) -> str:
@@ -190,42 +230,38 @@ def _rotvec_between(target: np.ndarray, current: np.ndarray) -> np.ndarray:
 
 
 class _SerialModel:
-    """NumPy FK and geometric Jacobian of a pytorch-kinematics serial chain (small batches, NumPy IK).
+    """NumPy FK and geometric Jacobian of a serial chain (small batches, NumPy IK).
 
-    Built from the chain's own model (static frame offsets, joint axes and
-    types), so it is the same kinematics; :meth:`KinematicChain.__init__`
-    checks it against pytorch-kinematics FK on random configurations and
-    falls back to pytorch-kinematics alone if they ever disagree (e.g. a
-    changed internal layout in a new pytorch-kinematics release).
-    Consecutive fixed frames are pre-multiplied, so one FK is ``dof + 1``
-    batched 4x4 products.
+    Built from the chain's static frame offsets, joint axes and types, read
+    from the URDF as pytorch-kinematics reads them (:meth:`from_urdf`); or
+    taken from a pytorch-kinematics chain's own arrays (:meth:`from_pk`,
+    which the tests compare it with, bit for bit). Consecutive fixed frames are
+    pre-multiplied, so one FK is ``dof + 1`` batched 4x4 products.
     """
 
-    def __init__(self, chain) -> None:
-        static = chain._static_offsets.detach().cpu().numpy()
-        jtype = chain.joint_type_indices.detach().cpu().numpy()
-        jidx = chain.joint_indices.detach().cpu().numpy()
-        parent = chain._direct_parent_idx.detach().cpu().numpy()
-        axes = chain.axes.detach().cpu().numpy()
-        order = [int(f) for level in chain._bfs_levels for f in level.reshape(-1).tolist()]
-        for a, b in zip(order, order[1:]):
-            if parent[b] != a:
-                raise ValueError("not a serial chain")
-        if int(chain._serial_eef_frame_idx) != order[-1]:
-            raise ValueError("end effector is not the last frame")
+    def __init__(
+        self,
+        static: Sequence[np.ndarray],
+        kinds: Sequence[int],
+        joint_index: Sequence[int],
+        axes: Sequence[np.ndarray],
+    ) -> None:
+        """Frames root -> tip: ``static[f]`` their fixed offsets, ``kinds[f]`` 0 fixed / 1 revolute /
+        2 prismatic, ``joint_index[f]`` the index into q of a movable one, ``axes[k]`` joint k's axis."""
         pre = np.eye(4)
         self.pre: list[np.ndarray] = []  #: fixed transform before movable joint k
         self.joint: list[int] = []  #: index into q of movable joint k
         self.prismatic: list[bool] = []
         self.axis: list[np.ndarray] = []
-        for f in order:
+        for f in range(len(static)):
             pre = pre @ static[f]
-            if jtype[f] == 0:
+            if kinds[f] == 0:
                 continue
             self.pre.append(pre)
-            self.joint.append(int(jidx[f]))
-            self.prismatic.append(bool(jtype[f] == 2))
-            self.axis.append(axes[int(jidx[f])] / np.linalg.norm(axes[int(jidx[f])]))
+            self.joint.append(int(joint_index[f]))
+            self.prismatic.append(bool(kinds[f] == 2))
+            ax = np.asarray(axes[int(joint_index[f])])
+            self.axis.append(ax / np.linalg.norm(ax))
             pre = np.eye(4)
         self.post = pre  #: fixed transform after the last movable joint (to the tip)
         if not self.pre:
@@ -243,6 +279,38 @@ class _SerialModel:
         self._any_prismatic = bool(self._pris_mask.any())
         self._joint_idx = np.array(self.joint, dtype=np.intp)
         self._identity_order = self.joint == list(range(len(self.joint)))
+
+    @classmethod
+    def from_urdf(cls, spec) -> _SerialModel:
+        """From a :class:`~.urdf_chain.SerialChainSpec`: the root frame (identity), then a frame per joint."""
+        static = [np.eye(4)] + [j.offset for j in spec.joints]
+        kinds = [0] + [j.kind for j in spec.joints]
+        index, k = [0], 0
+        for j in spec.joints:
+            index.append(k if j.kind else 0)
+            k += bool(j.kind)
+        return cls(static, kinds, index, [j.axis for j in spec.movable])
+
+    @classmethod
+    def from_pk(cls, chain) -> _SerialModel:
+        """From a pytorch-kinematics serial chain's own arrays."""
+        static = chain._static_offsets.detach().cpu().numpy()
+        jtype = chain.joint_type_indices.detach().cpu().numpy()
+        jidx = chain.joint_indices.detach().cpu().numpy()
+        parent = chain._direct_parent_idx.detach().cpu().numpy()
+        axes = chain.axes.detach().cpu().numpy()
+        order = [int(f) for level in chain._bfs_levels for f in level.reshape(-1).tolist()]
+        for a, b in zip(order, order[1:]):
+            if parent[b] != a:
+                raise ValueError("not a serial chain")
+        if int(chain._serial_eef_frame_idx) != order[-1]:
+            raise ValueError("end effector is not the last frame")
+        return cls(
+            [static[f] for f in order],
+            [int(jtype[f]) for f in order],
+            [int(jidx[f]) for f in order],
+            list(axes),
+        )
 
     def fk_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tip transforms (B, 4, 4) and geometric Jacobians (B, 6, dof), root frame, rows (v, omega).
@@ -305,13 +373,12 @@ class KinematicChain:
         text = _read(urdf)
         self.root_link = root_link
         self.tip_link = tip_link
-        self.chain = _quiet_build(
-            pk.build_serial_chain_from_urdf, text.encode(), tip_link, root_link
-        ).to(dtype=DTYPE)
-        self.joint_names: list[str] = list(self.chain.get_joint_parameter_names(exclude_fixed=True))
-        low, high = self.chain.get_joint_limits()
-        self.lower = np.array(low, dtype=float)
-        self.upper = np.array(high, dtype=float)
+        self._text = text
+        self._pk_chain: Any = None
+        spec = read_serial_chain(text, root_link, tip_link)  # ValueError naming a link off the path
+        self.joint_names: list[str] = [j.name for j in spec.movable]
+        self.lower = np.array([j.lower for j in spec.movable], dtype=float)
+        self.upper = np.array([j.upper for j in spec.movable], dtype=float)
         for name, (lo, hi) in (limits or {}).items():
             k = self.joint_names.index(name)
             if not lo < hi:
@@ -324,25 +391,34 @@ class KinematicChain:
         )
         if unbounded.any():
             self.lower[unbounded], self.upper[unbounded] = -np.pi, np.pi
-        if unbounded.any() or limits:
-            self.chain.low = torch.as_tensor(self.lower, dtype=DTYPE)
-            self.chain.high = torch.as_tensor(self.upper, dtype=DTYPE)
-        self._np: _SerialModel | None = None
-        try:
-            model = _SerialModel(self.chain)
-            q = self.sample(8, torch.Generator().manual_seed(0))
-            dp, dr = pose_error(model.fk_jacobian(q)[0], self._fk_pk(q))
-            if float(dp.max()) < 1e-9 and float(dr.max()) < 1e-7:
-                self._np = model
-        except Exception:  # noqa: BLE001 - an unexpected chain layout: pytorch-kinematics alone
-            self._np = None
+        self._np = _SerialModel.from_urdf(spec)
+
+    @property
+    def chain(self) -> Any:
+        """The pytorch-kinematics serial chain (built on first use: large batches, tests).
+
+        Its limits are this chain's (soft limits, continuous joints in [-pi, pi]).
+        """
+        if self._pk_chain is None:
+            import torch
+
+            pk = _pk()
+            c = _quiet_build(
+                pk.build_serial_chain_from_urdf, self._text.encode(), self.tip_link, self.root_link
+            ).to(dtype=torch.float64)
+            c.low = torch.as_tensor(self.lower, dtype=torch.float64)
+            c.high = torch.as_tensor(self.upper, dtype=torch.float64)
+            self._pk_chain = c
+        return self._pk_chain
 
     @property
     def dof(self) -> int:
         return len(self.joint_names)
 
     def _q(self, q: np.ndarray | Sequence[float] | torch.Tensor) -> torch.Tensor:
-        t = torch.as_tensor(np.asarray(q, dtype=float), dtype=DTYPE)
+        import torch
+
+        t = torch.as_tensor(np.asarray(q, dtype=float), dtype=torch.float64)
         return t.reshape(-1, self.dof)
 
     def fk(self, q) -> np.ndarray:
@@ -353,7 +429,7 @@ class KinematicChain:
         large ones through pytorch-kinematics.
         """
         qa = np.asarray(q, dtype=float).reshape(-1, self.dof)
-        if self._np is not None and qa.shape[0] <= _NUMPY_FK_MAX_BATCH:
+        if qa.shape[0] <= _NUMPY_FK_MAX_BATCH:
             return self._np.fk_jacobian(qa)[0]
         return self._fk_pk(qa)
 
@@ -367,23 +443,24 @@ class KinematicChain:
         Small batches use the NumPy model, as :meth:`fk` does.
         """
         qa = np.asarray(q, dtype=float).reshape(-1, self.dof)
-        if self._np is not None and qa.shape[0] <= _NUMPY_FK_MAX_BATCH:
+        if qa.shape[0] <= _NUMPY_FK_MAX_BATCH:
             return self._np.fk_jacobian(qa)[1]
         return self.chain.jacobian(self._q(qa)).detach().numpy()
 
-    def sample(self, n: int, generator: torch.Generator, margin: float = 0.0) -> np.ndarray:
+    def sample(
+        self, n: int, generator: UniformStream | torch.Generator, margin: float = 0.0
+    ) -> np.ndarray:
         """``n`` joint vectors uniform within limits shrunk by ``margin`` on each side."""
-        lo = torch.as_tensor(self.lower + margin, dtype=DTYPE)
-        hi = torch.as_tensor(self.upper - margin, dtype=DTYPE)
-        u = torch.rand(n, self.dof, generator=generator, dtype=DTYPE)
-        return (lo + u * (hi - lo)).numpy()
+        lo = self.lower + margin
+        hi = self.upper - margin
+        return lo + _uniform(generator, n, self.dof) * (hi - lo)
 
     def ik(
         self,
         targets: np.ndarray,
         *,
         seed_q: np.ndarray | Sequence[float] | None = None,
-        generator: torch.Generator | None = None,
+        generator: UniformStream | torch.Generator | None = None,
         seed: int = 0,
         config: IKConfig = IKConfig(),
     ) -> IKResult:
@@ -401,7 +478,7 @@ class KinematicChain:
         restarts. Deterministic for a given seed/generator state.
         """
         tgt = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
-        gen = generator if generator is not None else torch.Generator().manual_seed(seed)
+        gen = generator if generator is not None else UniformStream(seed)
         ref = (
             None
             if seed_q is None
@@ -409,7 +486,7 @@ class KinematicChain:
                 np.asarray(seed_q, dtype=float).reshape(-1, self.dof), (tgt.shape[0], self.dof)
             )
         )
-        if ref is not None and config.seed_first and self._np is not None:
+        if ref is not None and config.seed_first:
             first = self._ik_seeded(tgt, ref, config)
             miss = np.flatnonzero(~first.success)
             if miss.size == 0:
@@ -532,7 +609,11 @@ class KinematicChain:
         return q.reshape(b, r, dof), ep.reshape(b, r), er.reshape(b, r), conv.reshape(b, r)
 
     def _ik_restarts(
-        self, tgt: np.ndarray, ref: np.ndarray | None, gen: torch.Generator, config: IKConfig
+        self,
+        tgt: np.ndarray,
+        ref: np.ndarray | None,
+        gen: UniformStream | torch.Generator,
+        config: IKConfig,
     ) -> IKResult:
         """The batched pytorch-kinematics solver: seed (if any) + random restarts, two passes."""
         res = self._ik_pass(tgt, ref, gen, config, config.num_retries, config.max_iterations)
@@ -571,58 +652,55 @@ class KinematicChain:
         self,
         targets: np.ndarray,
         seed_q: np.ndarray | None,
-        gen: torch.Generator,
+        gen: UniformStream | torch.Generator,
         config: IKConfig,
         r: int,
         iterations: int,
     ) -> IKResult:
-        tgt = torch.as_tensor(targets, dtype=DTYPE)
-        b = tgt.shape[0]
-        init = torch.as_tensor(self.sample(b * r, gen), dtype=DTYPE).reshape(b, r, self.dof)
+        b = targets.shape[0]
+        init = self.sample(b * r, gen).reshape(b, r, self.dof)
         ref = None
         if seed_q is not None:
-            ref = (
-                torch.as_tensor(np.array(seed_q, dtype=float), dtype=DTYPE)
-                .reshape(-1, self.dof)
-                .expand(b, self.dof)
+            ref = np.broadcast_to(
+                np.array(seed_q, dtype=float).reshape(-1, self.dof), (b, self.dof)
             )
-            init[:, 0, :] = torch.clamp(
-                ref, torch.as_tensor(self.lower), torch.as_tensor(self.upper)
+            init[:, 0, :] = np.clip(ref, self.lower, self.upper)
+        if b * r <= _NUMPY_IK_MAX_ROWS:
+            q, ep, er, conv = self._dls(
+                targets, init, config, iterations, stop_when_any=ref is None
             )
-        if self._np is not None and b * r <= _NUMPY_IK_MAX_ROWS:
-            qn, ep, er, cv = self._dls(
-                targets, init.numpy(), config, iterations, stop_when_any=ref is None
-            )
-            q, conv = torch.as_tensor(qn), torch.as_tensor(cv)
-            err = torch.as_tensor(ep + 0.1 * er)
+            err = ep + 0.1 * er
         else:
-            q, err, conv = self._pk_solve(tgt, init, config, iterations, ref is None)
-        score = torch.where(conv, torch.zeros_like(err), err + 1.0)
+            q, err, conv = self._pk_solve(targets, init, config, iterations, ref is None)
+        score = np.where(conv, 0.0, err + 1.0)
         if ref is not None:
-            dist = (q - ref[:, None, :]).norm(dim=-1)
-            score = score + torch.where(conv, dist * 1e-3, torch.zeros_like(dist))
-        best = score.argmin(dim=1)
-        idx = torch.arange(b)
-        qb = q[idx, best].clamp(torch.as_tensor(self.lower), torch.as_tensor(self.upper))
-        reached = self.fk(qb.numpy())
-        dp, dr = pose_error(reached, tgt.numpy())
+            dist = np.sqrt(np.sum((q - ref[:, None, :]) ** 2, axis=-1))
+            score = score + np.where(conv, dist * 1e-3, 0.0)
+        best = score.argmin(axis=1)
+        qb = np.clip(q[np.arange(b), best], self.lower, self.upper)
+        reached = self.fk(qb)
+        dp, dr = pose_error(reached, targets)
         ok = (dp <= max(config.pos_tolerance, 1e-9) * 1.0001) & (
             dr <= config.rot_tolerance * 1.0001
         )
-        return IKResult(q=qb.numpy(), success=ok, pos_error=dp, rot_error=dr)
+        return IKResult(q=qb, success=ok, pos_error=dp, rot_error=dr)
 
     def _pk_solve(
         self,
-        tgt: torch.Tensor,
-        init: torch.Tensor,
+        targets: np.ndarray,
+        init: np.ndarray,
         config: IKConfig,
         iterations: int,
         any_converged: bool,
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """pytorch-kinematics' batched ``PseudoInverseIK`` (large batches): q (B, R, dof), error, converged."""
+        import torch
+
+        pk = _pk()
+        tinit = torch.as_tensor(init, dtype=torch.float64)
         solver = pk.PseudoInverseIK(
             self.chain,
-            retry_configs=init[0],
+            retry_configs=tinit[0],
             max_iterations=iterations,
             pos_tolerance=config.pos_tolerance,
             rot_tolerance=config.rot_tolerance,
@@ -635,9 +713,11 @@ class KinematicChain:
         )
         # The constructor takes one (R, dof) block shared by all targets; a (B, R, dof) block set
         # afterwards gives every target its own restarts (solve() reshapes it to (B*R, dof)).
-        solver.initial_config = init
-        sol = solver.solve(pk.Transform3d(matrix=tgt, dtype=DTYPE))
-        return sol.solutions, sol.err_pos + sol.err_rot * 0.1, sol.converged
+        solver.initial_config = tinit
+        tgt = torch.as_tensor(targets, dtype=torch.float64)
+        sol = solver.solve(pk.Transform3d(matrix=tgt, dtype=torch.float64))
+        err = sol.err_pos + sol.err_rot * 0.1
+        return sol.solutions.numpy(), err.numpy(), sol.converged.numpy()
 
 
 class KinematicTree:
@@ -647,12 +727,18 @@ class KinematicTree:
     """
 
     def __init__(self, urdf: str | Path) -> None:
+        import torch
+
         text = _read(urdf)
-        self.chain = _quiet_build(pk.build_chain_from_urdf, text.encode()).to(dtype=DTYPE)
+        self.chain = _quiet_build(_pk().build_chain_from_urdf, text.encode()).to(
+            dtype=torch.float64
+        )
         self.joint_names: list[str] = list(self.chain.get_joint_parameter_names(exclude_fixed=True))
 
     def fk(self, q: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
-        vec = torch.zeros(1, len(self.joint_names), dtype=DTYPE)
+        import torch
+
+        vec = torch.zeros(1, len(self.joint_names), dtype=torch.float64)
         for name, v in (q or {}).items():
             vec[0, self.joint_names.index(name)] = float(v)
         out = self.chain.forward_kinematics(vec)

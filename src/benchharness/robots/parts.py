@@ -14,23 +14,23 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-import torch
 
 from ..backends.interface import BodyId
 from ..geometry import Pose
 from .config import ArmConfig, GripperConfig
-from .kinematics import IKConfig, IKResult, KinematicChain, pose_error
+from .kinematics import IKConfig, IKResult, KinematicChain, UniformStream, pose_error
 from .trajectory import QuinticTrajectory
 
 if TYPE_CHECKING:
+    import torch
+
     from .robot import Robot
 
 __all__ = ["GraspResult", "Gripper", "MotionResult", "RobotArm", "RobotHand"]
 
 #: KinematicChains built in this process, by (URDF text, root, tip, limits). A chain is immutable once
-#: built (IK draws from the generator it is given), and building one parses the whole URDF with
-#: pytorch-kinematics and checks the NumPy model against it (~0.3 s for the PR2): a worker running many
-#: trials, or a strategy that makes a new robot, builds each chain once.
+#: built (IK draws from the generator it is given), and building one parses the whole URDF: a worker
+#: running many trials, or a strategy that makes a new robot, builds each chain once.
 _CHAINS: dict[tuple, KinematicChain] = {}
 
 
@@ -132,7 +132,7 @@ class RobotArm:
         targets: np.ndarray,
         *,
         seed_q=None,
-        generator: torch.Generator | None = None,
+        generator: UniformStream | torch.Generator | None = None,
         seed: int = 0,
         config: IKConfig | None = None,
     ) -> IKResult:
@@ -254,7 +254,7 @@ class RobotArm:
         Jacobian-transpose-pseudoinverse of the position rows only.
         """
         t = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
-        gen = generator if generator is not None else torch.Generator().manual_seed(seed)
+        gen = generator if generator is not None else UniformStream(seed)
         b = t.shape[0]
         best_q = np.zeros((b, self.chain.dof))
         best_e = np.full(b, np.inf)
@@ -300,7 +300,7 @@ class RobotArm:
         duration: float | None = None,
         velocity_scale: float | None = None,
         settle: float = 0.3,
-        generator: torch.Generator | None = None,
+        generator: UniformStream | torch.Generator | None = None,
         seed: int = 0,
         seed_q: np.ndarray | None = None,
     ) -> MotionResult:

@@ -18,7 +18,7 @@ from .descriptions.pr2 import (
     PAD_GAP,
 )
 
-if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+if TYPE_CHECKING:  # the robot loads with the robot, not with its config (robot_meta reads configs)
     from .robot import Robot
 
 __all__ = [

@@ -21,7 +21,7 @@ from .config import ArmConfig, RobotConfig
 from .descriptions.pr2_gripper import MOUNT_RPY, SIDE, STAGE_EFFORT, WRIST_EFFORT
 from .pr2 import pr2_gripper_part
 
-if TYPE_CHECKING:  # torch loads with the robot, not with its config (robot_meta reads configs)
+if TYPE_CHECKING:  # the robot loads with the robot, not with its config (robot_meta reads configs)
     from .robot import Robot
 
 __all__ = ["STAGE_JOINTS", "pr2_gripper_config", "make_pr2_gripper", "stage_joints_for", "MOUNT"]
