@@ -22,6 +22,7 @@ from benchharness.inertia import (
     convex_hull_properties,
     cylinder_inertia,
     cylinder_volume,
+    parallel_axis,
     sphere_inertia,
     sphere_volume,
 )
@@ -101,3 +102,14 @@ def test_mesh_shape_uses_the_hull():
     v, _, tensor = shape_volume_com_inertia(MeshShape(box.vertices, box.faces))
     assert v == pytest.approx(0.001, rel=1e-12)
     np.testing.assert_allclose(np.diag(tensor), box_inertia(v, (0.2, 0.1, 0.05)), rtol=1e-10)
+
+
+def test_parallel_axis_moves_a_box_inertia_to_a_point_off_its_centre():
+    """box_inertia + parallel_axis vs trimesh's inertia of the offset box about the origin."""
+    size, d = (0.2, 0.1, 0.05), np.array([0.03, -0.12, 0.07])
+    mesh = trimesh.creation.box(extents=size)
+    mesh.apply_translation(d)
+    mesh.density = 1.0
+    about_origin = mesh.moment_inertia_frame(np.eye(4)) * (MASS / mesh.volume)
+    ours = np.diag(box_inertia(MASS, size)) + parallel_axis(MASS, d)
+    np.testing.assert_allclose(ours, about_origin, rtol=1e-12, atol=1e-15)

@@ -35,6 +35,7 @@ __all__ = [
     "sphere_volume",
     "sphere_inertia",
     "convex_hull_properties",
+    "parallel_axis",
 ]
 
 
@@ -89,3 +90,14 @@ def convex_hull_properties(vertices) -> tuple[float, np.ndarray, np.ndarray]:
         np.asarray(hull.center_mass, dtype=float),
         np.asarray(hull.moment_inertia, dtype=float),
     )
+
+
+def parallel_axis(mass: float, offset: Sequence[float] | np.ndarray) -> np.ndarray:
+    """The parallel-axis (Steiner) term ``m (|d|^2 I - d d^T)``: add it to a part's inertia about its
+    own centre to get its inertia about a point ``offset`` away (a composite body's centre).
+
+    One place for the composite bodies of the object models, the URDF builder and the backends'
+    multi-shape links, which each wrote it out before.
+    """
+    d = np.asarray(offset, dtype=float)
+    return mass * (np.dot(d, d) * np.eye(3) - np.outer(d, d))

@@ -30,6 +30,7 @@ from ..inertia import (
     convex_hull_properties,
     cylinder_inertia,
     cylinder_volume,
+    parallel_axis,
     sphere_inertia,
     sphere_volume,
 )
@@ -101,7 +102,7 @@ def mass_properties(
     i_body = np.zeros((3, 3))
     for v, c, i in zip(vols, centres, tensors):
         d = c - c_body
-        i_body += density * (i + v * (np.dot(d, d) * np.eye(3) - np.outer(d, d)))
+        i_body += density * (i + parallel_axis(v, d))
     if com is not None:
         c_body = np.asarray(com, dtype=float)
     if inertia_diag is not None:

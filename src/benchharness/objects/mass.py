@@ -25,6 +25,7 @@ import trimesh
 
 from ..backends._urdf import shape_volume_com_inertia
 from ..backends.interface import Shape
+from ..inertia import parallel_axis
 
 __all__ = ["MassProperties", "shape_volume", "mass_properties"]
 
@@ -78,7 +79,7 @@ def mass_properties(shapes: Sequence[Shape], mass: float) -> MassProperties:
     inertia = np.zeros((3, 3))
     for v, c, i_unit in parts:
         d = c - com
-        inertia += rho * (i_unit + v * (np.dot(d, d) * np.eye(3) - np.outer(d, d)))
+        inertia += rho * (i_unit + parallel_axis(v, d))
     return MassProperties(
         mass=float(mass), com=np.asarray(com, float), inertia=inertia, volume=float(vol)
     )

@@ -37,6 +37,7 @@ from ..inertia import (
     box_volume,
     cylinder_inertia,
     cylinder_volume,
+    parallel_axis,
     sphere_inertia,
     sphere_volume,
 )
@@ -91,7 +92,7 @@ def composite_inertia(geoms: Sequence[Geom], mass: float) -> tuple[np.ndarray, n
     inertia = np.zeros((3, 3))
     for g, m, c in zip(geoms, masses, centres):
         r = c - com
-        inertia += shape_inertia(g, m) + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
+        inertia += shape_inertia(g, m) + parallel_axis(m, r)
     return com, inertia
 
 
