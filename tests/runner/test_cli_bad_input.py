@@ -32,7 +32,10 @@ def _trials_stored(path) -> int:
 
 
 def _refused(command, args, store_path, *needles):
+    existed = store_path.exists()
     r = CliRunner().invoke(command, [*args, "--store", str(store_path)], catch_exceptions=False)
+    # refused before the store is opened: no file is created for a command that runs nothing
+    assert store_path.exists() == existed
     assert r.exit_code == 2, r.output
     lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1, r.stderr
@@ -82,6 +85,16 @@ def test_physics_config_itself_refuses_what_no_engine_can_simulate():
 
 def test_reversed_trial_range_is_refused(store_path):
     _refused(run, [*RUN5, "--trials", "5-3"], store_path, "'5-3'")
+
+
+@pytest.mark.parametrize("command", [run, compare])
+def test_a_trial_the_task_lacks_is_refused_before_the_store_is_opened(store_path, command):
+    _refused(command, [*RUN5, "--trials", "2,7"], store_path, "no trial 7", "1..5")
+
+
+@pytest.mark.parametrize("command", [run, compare])
+def test_negative_workers_are_refused_before_the_store_is_opened(store_path, command):
+    _refused(command, [*RUN, "--workers", "-1"], store_path, "--workers -1")
 
 
 @pytest.mark.parametrize("seed", [str(2**63), str(2**64 + 5), "-1"])

@@ -174,13 +174,16 @@ def _spec(
     wall_budget,
     plugins,
     strategy_kv=(),
+    trial_sel=None,
+    workers=None,
 ):
+    """The run's :class:`RunSpec`, every argument checked before a store is opened (exit 2 naming one)."""
     from ..plugin import PluginNotFoundError
     from ..runner.contract import TimeBudget
     from ..runner.options import normalise_options
     from ..runner.plugins import check_strategy_robot, lookup
     from ..runner.spec import RunSpec, parse_physics
-    from ..runner.tasks import plan_task
+    from ..runner.tasks import parse_trial_selection, plan_task
     from .validate import check_seed
 
     try:
@@ -190,12 +193,15 @@ def _spec(
         fail(str(exc) if str(exc).startswith("--") else f"--physics: {exc}")
     if repeats < 1:
         fail("--repeats must be at least 1")
+    if workers is not None and workers < 0:
+        fail(f"--workers {workers}: must be 0 or more")
     for name, value in (("--sim-budget", sim_budget), ("--wall-budget", wall_budget)):
         if value is not None and not (value > 0 and value != float("inf")):  # NaN fails too
             fail(f"{name} {value}: must be a positive finite number of seconds")
     try:
         item = lookup("task", task, tuple(plugins))
         plan = plan_task(item.name, item.create(), seed, repeats)
+        parse_trial_selection(trial_sel, sorted(plan.items))
         check_strategy_robot(strategy, robot, tuple(plugins))
         strategy_item = lookup("strategy", strategy, tuple(plugins))
         options = normalise_options(
@@ -478,6 +484,8 @@ def run(
         wall_budget,
         plugins,
         strategy_kv,
+        trial_sel,
+        workers,
     )
     video = None
     if video_path is not None:
@@ -797,25 +805,31 @@ def compare(
         names = check_backends(_names(backends))
     except ValueError as exc:
         fail(str(exc))
+    # every backend's run checked before the store is opened
+    specs = [
+        _spec(
+            task,
+            robot,
+            strategy,
+            b,
+            seed,
+            sensors,
+            repeats,
+            physics_kv,
+            sim_budget,
+            wall_budget,
+            plugins,
+            strategy_kv,
+            trial_sel,
+            workers,
+        )
+        for b in names
+    ]
     runs = []
     with _open_store(store_path) as store:
         benchmark = None
         required = None
-        for b in names:
-            spec = _spec(
-                task,
-                robot,
-                strategy,
-                b,
-                seed,
-                sensors,
-                repeats,
-                physics_kv,
-                sim_budget,
-                wall_budget,
-                plugins,
-                strategy_kv,
-            )
+        for b, spec in zip(names, specs):
             report = _sweep(spec, store, workers, trial_sel, retry_failed, progress)
             benchmark = report.plan.benchmark
             required = report.plan.total if trial_sel is None else None
