@@ -650,6 +650,22 @@ def test_visual_shapes_are_render_only(make):
     b.close()
 
 
+def test_set_visuals_off_changes_no_physics_and_draws_no_colour(make):
+    """``set_visuals(False)`` (an unfilmed trial): the same fall, bit for bit; no colour drawn."""
+    a, b = make(), make()
+    b.set_visuals(False)
+    assert a.draws_visuals and not b.draws_visuals
+    ba, bb = _visual_scene(a, True), _visual_scene(b, True)
+    a.step(120)
+    b.step(120)
+    pa, pb_ = a.get_pose(ba), b.get_pose(bb)
+    np.testing.assert_array_equal(pa.p, pb_.p)
+    np.testing.assert_array_equal(pa.q, pb_.q)
+    if b.capabilities.camera:
+        img = b.render(TOP_CAM)
+        assert _pixels_like(img, GREEN) == 0 and _pixels_like(img, RED) == 0
+
+
 def test_urdf_visual_colours_are_render_only(backend: Backend, tmp_path: Path):
     """A URDF link's ``<visual>`` with a material colour is drawn where there is a camera, never hit."""
     urdf = tmp_path / "painted.urdf"

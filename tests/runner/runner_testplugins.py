@@ -233,7 +233,7 @@ class ConfiguredConfig:
 
 
 class ConfiguredStrategy(DropStrategy):
-    """Drops the cube as test-drop, and keeps the configuration it ran with in ``extra``."""
+    """Drops the cube as test-drop; records its configuration and whether the backend draws visuals."""
 
     def __init__(self, config: ConfiguredConfig | None = None) -> None:
         self.config = config or ConfiguredConfig()
@@ -241,6 +241,7 @@ class ConfiguredStrategy(DropStrategy):
     def run_trial(self, ctx):
         out = super().run_trial(ctx)
         ctx.recorder.event("config", **dataclasses.asdict(self.config))
+        ctx.recorder.event("backend", draws_visuals=ctx.backend.draws_visuals)
         return out
 
 

@@ -127,6 +127,33 @@ def test_filming_changes_no_result_and_is_deterministic(invoke, tmp_path):
     assert not np.array_equal(a[0], a[-1])  # the clock runs (and the box falls)
 
 
+def test_only_the_filmed_trial_builds_drawn_geometry(invoke, tmp_path):
+    """Backend.set_visuals: colours and render-only shapes for the filmed trial, none for the rest."""
+    pytest.importorskip("imageio_ffmpeg")
+    args = ["--task", "Rubiks-5-5", "--strategy", "test-configured", *BASE, "--json"]
+    r = invoke(
+        run,
+        *args,
+        "--video",
+        str(tmp_path / "t.mp4"),
+        "--video-trial",
+        "2",
+        "--video-size",
+        "160x120",
+        store=tmp_path / "a.sqlite",
+    )
+    assert r.exit_code == 0, r.output
+    import sqlite3
+
+    with sqlite3.connect(tmp_path / "a.sqlite") as db:
+        rows = db.execute("SELECT trial_index, diagnostics_json FROM trials").fetchall()
+    drawn = {
+        i: next(e for e in json.loads(d)["events"] if e["kind"] == "backend")["draws_visuals"]
+        for i, d in rows
+    }
+    assert drawn == {1: False, 2: True, 3: False, 4: False, 5: False}
+
+
 @pytest.mark.slow
 def test_a_pr2_trial_scores_the_same_filmed(invoke, tmp_path):
     """Rubiks-1-5, PR2, exact dead reckoning: the stored score and status do not depend on --video."""

@@ -259,12 +259,26 @@ class Backend(abc.ABC):
         self._step_callbacks: dict[int, StepCallback] = {}  # handle -> fn, in registration order
         self._next_step_callback = 1
         self._in_step_callback = False
+        #: bodies added from now on carry what :meth:`render` draws beyond their collision shapes
+        #: (colours, render-only shapes); see :meth:`set_visuals`
+        self.draws_visuals = True
 
     @property
     def solver_iterations(self) -> int:
         """The solver iterations in force: the config's, or this engine's default."""
         n = self.config.solver_iterations
         return self.default_solver_iterations if n is None else int(n)
+
+    def set_visuals(self, enabled: bool) -> None:
+        """Whether bodies added from now on carry drawn geometry (colours, render-only shapes).
+
+        Never changes physics: collision shapes, masses and contacts are the
+        same either way. The runner turns it off for every trial that is not
+        filmed, because building a coloured mesh is CPU spent for no one
+        (PyBullet: trimesh's import and ~0.1 s a stickered cube, measured). A
+        backend without a renderer may ignore it.
+        """
+        self.draws_visuals = bool(enabled)
 
     # -- lifetime ------------------------------------------------------------
     @abc.abstractmethod

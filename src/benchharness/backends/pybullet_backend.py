@@ -476,7 +476,8 @@ class PyBulletBackend(Backend):
         cid = self._cid
         shapes = list(shapes)
         visuals = list(visuals)
-        coloured = bool(visuals) or any(s.rgba is not None for s in shapes)
+        # drawn geometry only where something may be filmed (set_visuals): it never changes physics
+        coloured = self.draws_visuals and (bool(visuals) or any(s.rgba is not None for s in shapes))
         mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         tmp: list[str] = []
         arrays = self._shape_arrays(shapes, tmp)  # mesh hulls are written to disk once, here

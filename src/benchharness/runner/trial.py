@@ -111,6 +111,8 @@ def execute_trial(
     try:
         physics = replace(spec.physics, seed=streams.backend_seed)
         backend = create_item("backend", spec.backend, spec.plugins, config=physics)
+        # colours and render-only shapes only for the trial being filmed (physics is the same)
+        backend.set_visuals(video is not None and video.trial_index == index)
         stage = "creating the robot, sensors and strategy"
         robot = create_item("robot", spec.robot, spec.plugins)
         sensors = {}
