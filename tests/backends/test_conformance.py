@@ -270,6 +270,32 @@ def test_joint_tracking(backend: Backend):
     assert np.all(np.abs(st.efforts) <= 50.0 + 1e-6)
 
 
+def test_retarget_joints_is_set_joint_targets(make):
+    """The per-step re-aim call: the same motion, bit for bit, as set_joint_targets, and it applies
+    new gains when it is given some (falling back to the full call)."""
+    worlds = []
+    for lean in (False, True):
+        b = make()
+        arm = b.load_urdf(ARM_URDF, Pose())
+        joints = [j.name for j in b.joint_info(arm)]
+        kp, kd, cap = [200.0, 150.0], [10.0, 8.0], [40.0, 30.0]
+        b.set_joint_targets(
+            arm, [0.0, 0.0], joints=joints, stiffness=kp, damping=kd, force_limit=cap
+        )
+        n = int(0.5 / b.config.timestep)
+        for i in range(n):
+            q, v = [0.8 * i / n, -0.5 * i / n], [0.8 / 0.5, -0.5 / 0.5]
+            if i == n // 2:
+                kp = [400.0, 300.0]  # new gains mid-way: the lean call must not keep the old ones
+            call = b.retarget_joints if lean else b.set_joint_targets
+            call(arm, q, v, joints=joints, stiffness=kp, damping=kd, force_limit=cap)
+            b.step()
+        worlds.append(b.get_joint_state(arm))
+    a, c = worlds
+    np.testing.assert_array_equal(a.positions, c.positions)
+    np.testing.assert_array_equal(a.velocities, c.velocities)
+
+
 def test_free_base_articulation_drives(backend: Backend):
     """The arm standing free on the ground reaches its joint targets (within 0.01 rad in 1 s)."""
     backend.add_ground()

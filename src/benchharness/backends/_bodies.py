@@ -116,6 +116,22 @@ class DriveState:
         self.kp[sel], self.kd[sel], self.fmax[sel] = cmd.k, cmd.d, cmd.f
         self.driven[sel] = True
 
+    def holds(
+        self,
+        sel: np.ndarray,
+        stiffness: Sequence[float],
+        damping: Sequence[float],
+        force_limit: Sequence[float],
+    ) -> bool:
+        """Joints ``sel`` are driven with exactly these gains and (finite) caps: a re-target needs
+        only new targets (:meth:`benchharness.backends.Backend.retarget_joints`)."""
+        return (
+            bool(self.driven[sel].all())
+            and self.kp[sel].tolist() == list(stiffness)
+            and self.kd[sel].tolist() == list(damping)
+            and self.fmax[sel].tolist() == list(force_limit)
+        )
+
     def efforts(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The capped drive law at ``(q, v)``, ``-sign(v) friction`` for undriven joints.
 

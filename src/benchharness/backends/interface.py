@@ -486,6 +486,37 @@ class Backend(abc.ABC):
         URDF effort limit. Targets persist until changed.
         """
 
+    def retarget_joints(
+        self,
+        body: BodyId,
+        positions: Sequence[float],
+        velocities: Sequence[float],
+        *,
+        joints: Sequence[str],
+        stiffness: Sequence[float],
+        damping: Sequence[float],
+        force_limit: Sequence[float],
+    ) -> None:
+        """:meth:`set_joint_targets` for a controller that re-aims the same joints every physics step.
+
+        Same arguments and the same effect (one value per joint, no
+        defaults). Why a second call: a fingertip linkage is re-aimed after
+        every physics step while a finger moves (~78,000 calls in a Rubiks-1-5
+        trial), and normalising the arguments cost more than the engine's
+        setters. A backend may therefore send only the targets when the
+        joints are already driven with exactly these gains and caps, and fall
+        back to :meth:`set_joint_targets` otherwise; this default always does.
+        """
+        self.set_joint_targets(
+            body,
+            positions,
+            velocities,
+            joints=joints,
+            stiffness=stiffness,
+            damping=damping,
+            force_limit=force_limit,
+        )
+
     def gravity_torques(self, body: BodyId) -> np.ndarray:
         """Joint torques/forces (:meth:`joint_names` order) that hold the body still against gravity.
 

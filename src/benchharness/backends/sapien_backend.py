@@ -551,6 +551,45 @@ class SapienBackend(Backend):
                 j.set_drive_velocity_target(vi)
             targets[i] = (qi, vi)
 
+    def retarget_joints(
+        self,
+        body: BodyId,
+        positions: Sequence[float],
+        velocities: Sequence[float],
+        *,
+        joints: Sequence[str],
+        stiffness: Sequence[float],
+        damping: Sequence[float],
+        force_limit: Sequence[float],
+    ) -> None:
+        b = self._b(body)
+        sel = b.joint_selection(joints)
+        if not b.drive.holds(sel, stiffness, damping, force_limit):
+            self.set_joint_targets(
+                body,
+                positions,
+                velocities,
+                joints=joints,
+                stiffness=stiffness,
+                damping=damping,
+                force_limit=force_limit,
+            )
+            return
+        q = np.asarray(positions, dtype=float)
+        v = np.asarray(velocities, dtype=float)
+        b.drive.target_q[sel], b.drive.target_v[sel] = q, v
+        targets = b.drive_targets
+        for i, qi, vi in zip(
+            sel.tolist(), q.tolist(), v.tolist()
+        ):  # as set_joint_targets sends them
+            j = b.sjoints[i]
+            last = targets.get(i)
+            if last is None or last[0] != qi:
+                j.set_drive_target(qi)
+            if last is None or last[1] != vi:
+                j.set_drive_velocity_target(vi)
+            targets[i] = (qi, vi)
+
     def gravity_torques(self, body: BodyId) -> np.ndarray:
         """Gravity holding torques in our joint order.
 

@@ -514,7 +514,7 @@ class Gripper:
         ):
             return
         self._link_sent = None if moving else t
-        be.set_joint_targets(
+        be.retarget_joints(
             self.robot.body,
             t,
             v,
