@@ -8,6 +8,8 @@ then holds the object.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import torch
@@ -276,6 +278,51 @@ def test_placement_squeeze_inside_friction_cone(task_id):
     assert new.max_gap < 5e-4 and new.penetration <= 5e-4
     assert np.all(new.grip_angles_deg <= 45.0), new.grip_angles_deg
     assert np.max(old.grip_angles_deg) > 45.0, old.grip_angles_deg
+
+
+@pytest.mark.parametrize(
+    "backend, object_mu, pair_mu", [("pybullet", 0.5, 0.5), ("sapien", 0.5, 0.75)]
+)
+def test_placement_cone_follows_the_contact_friction(backend, object_mu, pair_mu):
+    """The default cone is atan(mu) of the fingertip-object contact as the engine combines it
+    (Bullet: product, PhysX: mean, with the hand links' 1.0); a number or None overrides it."""
+    hand = _shared_hand()
+    be = get_manager().create("backend", backend)
+    try:
+        ex = InGraspExecutor(hand, ExecConfig(object_friction=object_mu))
+        assert ex.contact_friction(be) == pytest.approx(pair_mu)
+        assert ex.grip_cone_deg(ex.contact_friction(be)) == pytest.approx(
+            math.degrees(math.atan(pair_mu))
+        )
+        assert (
+            InGraspExecutor(hand).grip_cone_deg(InGraspExecutor(hand).contact_friction(be)) == 45.0
+        )
+    finally:
+        be.close()
+    assert (
+        InGraspExecutor(hand, ExecConfig(placement_grip_cone_deg=30.0)).grip_cone_deg(2.0) == 30.0
+    )
+    assert (
+        InGraspExecutor(hand, ExecConfig(placement_grip_cone_deg=None)).grip_cone_deg(2.0) is None
+    )
+    with pytest.raises(ValueError):
+        ExecConfig(placement_grip_cone_deg="mu")  # type: ignore[arg-type]
+
+
+def test_placement_widens_with_friction():
+    """banana-06's contacts-only placement squeezes 62 / 63 / 37 deg off the normals: outside the
+    45 deg cone of mu = 1 (so the placement moves), inside the 63.4 deg cone of mu = 2 (so it stays)."""
+    t = {x.task_id: x for x in published_tasks()}["banana-06"]
+    planner = InGraspPlanner("relaxed-rigidity")
+    problem = planner.problem(t)
+    ex = InGraspExecutor(planner.hand)
+    old = InGraspExecutor(planner.hand, ExecConfig(placement_grip_cone_deg=None)).placement(
+        problem, t.object
+    )
+    mu1, mu2 = ex.placement(problem, t.object, 1.0), ex.placement(problem, t.object, 2.0)
+    assert np.all(mu1.grip_angles_deg <= 45.0) and np.max(old.grip_angles_deg) > 45.0
+    assert np.all(old.grip_angles_deg <= math.degrees(math.atan(2.0)))
+    np.testing.assert_array_equal(mu2.pose, old.pose)
 
 
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])

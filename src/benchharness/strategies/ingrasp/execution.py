@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import torch
@@ -111,9 +111,12 @@ class ExecConfig:
         True  #: reached = executed displacement applied to H_i (paper's set-up correction)
     )
     max_placement_gap: float = 0.002  #: m, placement fit worse than this is refused (unreachable)
-    #: deg, friction cone half angle the set-up placement keeps the squeeze directions inside
-    #: (``placement.place_object``; 45 = atan of the default friction 1.0); None: contacts only
-    placement_grip_cone_deg: float | None = 45.0
+    #: friction cone half angle (deg) the set-up placement keeps the squeeze directions inside
+    #: (``placement.place_object``). ``"friction"`` (default): ``atan(mu)`` of the fingertip-object
+    #: contact's coefficient as the engine combines it (:meth:`Backend.pair_friction` of the object's
+    #: friction and the hand links' ``PhysicsConfig.default_friction``; 45 deg at the defaults, 1.0);
+    #: a number: that angle whatever the friction; None: contacts only (before 2026-12-02)
+    placement_grip_cone_deg: float | Literal["friction"] | None = "friction"
 
     def __post_init__(self) -> None:
         if self.palm not in PALM_ROTATIONS:
@@ -135,6 +138,14 @@ class ExecConfig:
                 raise ValueError(f"{name} must be >= 0")
         if self.object_friction is not None and self.object_friction < 0:
             raise ValueError("object_friction must be >= 0")
+        cone = self.placement_grip_cone_deg
+        if isinstance(cone, str):
+            if cone != "friction":
+                raise ValueError(
+                    f"placement_grip_cone_deg must be a number, 'friction' or None, not {cone!r}"
+                )
+        elif cone is not None and not 0.0 <= float(cone) <= 90.0:
+            raise ValueError("placement_grip_cone_deg must be in [0, 90] deg")
 
 
 @dataclass
@@ -213,15 +224,37 @@ class InGraspExecutor:
         self.config = config or ExecConfig()
 
     # ----------------------------------------------------------------- set-up geometry
-    def placement(self, problem: InGraspProblem, object_name: str) -> InGraspPlacement:
-        """Where the (noise-free) object sits at ``q_0``; cached per task and object."""
+    def grip_cone_deg(self, friction: float) -> float | None:
+        """The placement's friction cone half angle (deg) for a contact friction coefficient ``friction``.
+
+        ``atan(mu)`` with :attr:`ExecConfig.placement_grip_cone_deg` ``"friction"``; the configured
+        angle otherwise (None: no cone).
+        """
+        cone = self.config.placement_grip_cone_deg
+        if cone == "friction":
+            return float(np.degrees(np.arctan(float(friction))))
+        return None if cone is None else float(cone)
+
+    def contact_friction(self, backend) -> float:
+        """The fingertip-object friction coefficient in ``backend``: the engine's combination of the
+        object's (:attr:`ExecConfig.object_friction`, else the physics default) and the hand links'
+        (the physics default)."""
+        hand_mu = float(backend.config.default_friction)
+        obj_mu = hand_mu if self.config.object_friction is None else self.config.object_friction
+        return float(backend.pair_friction(obj_mu, hand_mu))
+
+    def placement(
+        self, problem: InGraspProblem, object_name: str, friction: float = 1.0
+    ) -> InGraspPlacement:
+        """Where the (noise-free) object sits at ``q_0`` for a contact friction ``friction``; cached
+        per task, object and friction cone."""
         return _cached_placement(
             self.hand,
             problem.task_id,
             object_name,
             tuple(np.round(problem.q_rest, 12)),
             problem.fingers,
-            self.config.placement_grip_cone_deg,
+            self.grip_cone_deg(friction),
         )
 
     # ----------------------------------------------------------------- the trial
@@ -253,7 +286,8 @@ class InGraspExecutor:
                 f"got {getattr(robot, 'name', robot)!r}"
             )
         wall0 = time.perf_counter()
-        place = self.placement(problem, object_name)
+        mu = self.contact_friction(backend)
+        place = self.placement(problem, object_name, mu)
         if place.max_gap > cfg.max_placement_gap:
             raise ValueError(
                 f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
@@ -313,6 +347,8 @@ class InGraspExecutor:
             "placement_penetration_mm": round(place.penetration * 1e3, 3),
             "placement_rotation_change_deg": round(place.rotation_change_deg, 3),
             "placement_grip_angles_deg": np.round(place.grip_angles_deg, 1).tolist(),
+            "contact_friction": round(mu, 6),
+            "placement_grip_cone_deg": self.grip_cone_deg(mu),
             "setup_noise_pos_mm": (dp * 1e3).round(4).tolist(),
             "setup_noise_rot_deg": round(
                 float(np.degrees(Rotation.from_matrix(dr).magnitude())), 4
