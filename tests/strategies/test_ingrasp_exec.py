@@ -326,6 +326,42 @@ def test_placement_widens_with_friction():
 
 
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+def test_gravity_compensation_carries_the_fingers(backend, task):
+    """Palm up and free, the fingers held at a grasp under plain PD settle where the spring carries
+    the fingers' weight, K (q0 - q) = tau_g(q) (static equilibrium); with the target shifted by
+    tau_g / K every control period they hold the grasp. The engine's inverse dynamics
+    (``finger_gravity``) is the only model of the weight used."""
+    from benchharness.geometry import Pose
+    from benchharness.strategies.ingrasp.execution import PALM_ROTATIONS, finger_gravity
+
+    m = get_manager()
+    q0 = InGraspPlanner("relaxed-rigidity").problem(task).q_rest
+    errs, tau_end = {}, {}
+    for comp in (False, True):
+        be = m.create("backend", backend)
+        try:
+            robot = m.create("robot", "allegro")
+            robot.spawn(be, Pose.from_rotation([0.0, 0.0, 0.4], PALM_ROTATIONS["up"]), q=q0)
+            hand = robot.gripper("hand")
+            kp = np.asarray(hand.config.stiffness, float)
+            for _ in range(120):  # 1 s, targets re-sent every 1/120 s as the executor does
+                tau = finger_gravity(be, robot, hand.joints)
+                hand.set_command(q0 + tau / kp if comp else q0)
+                be.step(max(1, int(round(1 / 120 / be.config.timestep))))
+            errs[comp] = robot.joint_positions()[:16] - q0
+            tau_end[comp] = finger_gravity(be, robot, hand.joints)
+        finally:
+            be.close()
+    sag = -tau_end[False] / kp  # plain PD at rest: K (q0 - q) = tau_g(q)
+    # palm up, the index and middle proximal joints (1, 5) carry their fingers horizontally:
+    # measured ~0.017 rad of sag on both engines, the largest gravity load of the hand
+    loaded = [1, 5]
+    assert np.all(np.abs(sag[loaded]) > 0.01), sag
+    np.testing.assert_allclose(errs[False][loaded], sag[loaded], rtol=0.15)
+    assert np.all(np.abs(errs[True][loaded]) < 0.1 * np.abs(sag[loaded])), errs[True]
+
+
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
 def test_setup_holds_banana_06(backend):
     """banana-06 dropped at set-up on both engines (all fingertip forces 0 N one control period after
     the "human" let go); placed inside the friction cones it is held by all three fingertips."""

@@ -68,7 +68,14 @@ from .planner import PlanResult
 from .problem import InGraspProblem
 from .rotations import pose_vector
 
-__all__ = ["ExecConfig", "ExecResult", "InGraspExecutor", "squeeze_offsets", "PALM_ROTATIONS"]
+__all__ = [
+    "ExecConfig",
+    "ExecResult",
+    "InGraspExecutor",
+    "squeeze_offsets",
+    "finger_gravity",
+    "PALM_ROTATIONS",
+]
 
 #: Palm frame (``palm_link``: fingers along +z, palm facing +x) in the world, per ``ExecConfig.palm``.
 PALM_ROTATIONS = {
@@ -117,6 +124,12 @@ class ExecConfig:
     #: friction and the hand links' ``PhysicsConfig.default_friction``; 45 deg at the defaults, 1.0);
     #: a number: that angle whatever the friction; None: contacts only (before 2026-12-02)
     placement_grip_cone_deg: float | Literal["friction"] | None = "friction"
+    #: add the fingers' gravity holding torques (the engine's inverse dynamics at the measured joints,
+    #: every control period) to the joint targets, as ``tau_g / K``: the PD spring's torque then goes
+    #: into the squeeze instead of carrying the fingers (palm up the proximal joints of index and
+    #: middle carry ~0.05 N m of finger weight against a ~0.13 N m squeeze). False: plain PD (before
+    #: 2026-12-02). docs/ingrasp.md, "Execution drops"
+    gravity_compensation: bool = True
 
     def __post_init__(self) -> None:
         if self.palm not in PALM_ROTATIONS:
@@ -204,6 +217,17 @@ def backoff_offsets(
     d = pos - pos.mean(axis=0)
     d = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9)
     return np.concatenate([np.linalg.pinv(jac[i]) @ (distance * d[i]) for i in range(len(fingers))])
+
+
+def finger_gravity(backend, robot, joints) -> np.ndarray:
+    """Gravity holding torques (N m) of ``joints`` of ``robot`` at its measured configuration.
+
+    The engine's own inverse dynamics (``Backend.gravity_torques``). Added to a PD drive's torque
+    (as a target shift ``tau / K``) it carries the fingers' weight, as the authors' Allegro PD node
+    does (joint PD plus KDL gravity compensation); the spring's torque is then the contact force's.
+    """
+    tau = np.asarray(backend.gravity_torques(robot.body), float)
+    return tau[robot.joint_index(list(joints))]
 
 
 def _mat(pose) -> np.ndarray:
@@ -405,11 +429,22 @@ class InGraspExecutor:
                     f"({state['com_dist'] * 100:.1f} cm at the grasp)"
                 )
 
+        grav = cfg.gravity_compensation and backend.capabilities.gravity_torques
+        cap = np.asarray(hand_grip.config.force_limit, float)
+
+        def command(q: np.ndarray) -> None:
+            """Joint targets ``q``; with gravity compensation shifted by ``tau_g / K`` (cap + |tau_g|)."""
+            if not grav:
+                hand_grip.set_command(q)
+                return
+            tau = finger_gravity(backend, robot, hand_grip.joints)
+            hand_grip.set_command(q + tau / kp, force_limit=cap + np.abs(tau))
+
         def run_for(seconds: float, target_fn, active: bool) -> None:
             n = max(1, int(round(seconds / (per * backend.config.timestep))))
             t0 = float(backend.time)
             for k in range(n):
-                hand_grip.set_command(target_fn(float(backend.time) - t0))
+                command(target_fn(float(backend.time) - t0))
                 backend.step(per)
                 if float(backend.time) - state["checked"] >= cfg.check_period - 1e-9 or k == n - 1:
                     state["checked"] = float(backend.time)
@@ -440,6 +475,11 @@ class InGraspExecutor:
                 if any(c.link_b == lk for c in backend.contacts(obj, robot.body))
             ]
             extra["setup_tip_contacts"] = sorted(tips_setup)
+            forces = {lk: 0.0 for lk in sorted(tip_links)}
+            for c in backend.contacts(obj, robot.body):
+                if c.link_b in forces:
+                    forces[c.link_b] += float(c.normal_force)
+            extra["setup_tip_forces_n"] = {k: round(v, 4) for k, v in forces.items()}
             extra["setup_joint_error_rad"] = round(
                 float(np.max(np.abs(robot.joint_positions()[idx] - q0[idx]))), 5
             )
