@@ -136,10 +136,20 @@ def main() -> None:
                     f"max|q-q_target|={err.max():.3f} rad (joint {used[int(err.argmax())]})"
                 )
             if args.normals:
+                tw = {
+                    k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3]
+                    for k in ("link_3_tip", "link_7_tip", "link_15_tip")
+                }
+                g = np.mean(list(tw.values()), axis=0)
                 for k in sorted(nrm):
                     n = nrm[k] / max(np.linalg.norm(nrm[k]), 1e-12)
+                    # the squeeze direction (towards the fingertip centroid) against the contact
+                    # normal: outside the friction cone (45 deg at mu = 1) the squeeze slides
+                    sq = palm[:3, :3].T @ (g - tw[k])
+                    ang = np.degrees(np.arccos(np.clip(n @ sq / np.linalg.norm(sq), -1.0, 1.0)))
                     rows.append(
-                        f"      {k}: normal(palm)=({n[0]:5.2f},{n[1]:5.2f},{n[2]:5.2f}) pen={pen[k] * 1e3:5.2f} mm"
+                        f"      {k}: normal(palm)=({n[0]:5.2f},{n[1]:5.2f},{n[2]:5.2f}) "
+                        f"pen={pen[k] * 1e3:5.2f} mm squeeze-normal angle={ang:5.1f} deg"
                     )
 
         be.add_body, be.detach, be.step = add_body_w, detach_w, step_w

@@ -317,3 +317,19 @@ def test_tip_rotation_against_the_object(hand, tasks):
     got = tip_rotation_deg(hand, problem.fingers, res.q)
     np.testing.assert_allclose(got, want, atol=1e-6)
     assert max(got) > 20.0  # apple-01: index and middle turn ~38 deg against the apple
+
+
+def test_relaxed_rigidity_and_point_contact_turn_the_fingertips_alike(hand, tasks):
+    """Both hold the fingertip centres on the object and leave their orientation free, so on a
+    reachable task they plan the same fingertip rotation against the object (apple-01: 38.7 / 37.0
+    / 11.0 deg), while ik-rigid, which holds the orientation, turns them far less
+    (docs/ingrasp.md, "Execution drops")."""
+    from benchharness.strategies.ingrasp.planner import tip_rotation_deg
+
+    problem = problem_from_task(tasks[0], hand)  # apple-01
+    rot = {
+        v: tip_rotation_deg(hand, problem.fingers, plan(hand, problem, v, IngraspConfig()).q)
+        for v in ("relaxed-rigidity", "point-contact", "ik-rigid")
+    }
+    np.testing.assert_allclose(rot["relaxed-rigidity"], rot["point-contact"], atol=0.5)
+    assert np.max(rot["ik-rigid"]) < 0.5 * np.max(rot["relaxed-rigidity"])
