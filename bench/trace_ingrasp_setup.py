@@ -28,7 +28,16 @@ def main() -> None:
     ap.add_argument("--every", type=float, default=0.05)
     ap.add_argument("--until-s", type=float, default=1.2, help="stop tracing after this sim time")
     ap.add_argument("--normals", action="store_true", help="print force-weighted contact normals")
-    ap.add_argument("--exec-config", default="", help="ExecConfig overrides, k=v,k=v (floats)")
+    ap.add_argument(
+        "--slip",
+        action="store_true",
+        help="print each fingertip's slip on the object since release (mm, object frame), the "
+        "fingertip distances (mm) and the largest joint tracking error of the used fingers (rad)",
+    )
+    ap.add_argument("--since-s", type=float, default=0.0, help="start tracing at this sim time")
+    ap.add_argument(
+        "--exec-config", default="", help="ExecConfig overrides, k=v,k=v (floats, none, friction)"
+    )
     args = ap.parse_args()
 
     spec = RunSpec(
@@ -42,7 +51,7 @@ def main() -> None:
         item = orig_create(kind, name, plugins, **kw)
         if kind == "strategy" and args.exec_config:
             over = {
-                k: (None if v.lower() == "none" else float(v))
+                k: (None if v.lower() == "none" else v if v == "friction" else float(v))
                 for k, v in (p.split("=") for p in args.exec_config.split(","))
             }
             item.exec_config = replace(item.exec_config, **over)
@@ -64,7 +73,12 @@ def main() -> None:
         def step_w(n=1):
             step(n)
             t = float(be.time)
-            if st["obj"] is None or t + 1e-9 < st["next"] or t > args.until_s:
+            if (
+                st["obj"] is None
+                or t + 1e-9 < st["next"]
+                or t > args.until_s
+                or t + 1e-9 < args.since_s
+            ):
                 return
             st["next"] = t + args.every
             rob = st["robot"]
@@ -96,11 +110,46 @@ def main() -> None:
                 f"t={t:6.3f} {st['phase']:8s} dCoM_palm[mm]=({d[0]:6.1f},{d[1]:6.1f},{d[2]:6.1f}) "
                 f"|v|={np.linalg.norm(v):5.3f} N: {tips} other={other:5.2f}"
             )
+            if args.slip:
+                tips_w = {
+                    k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3]
+                    for k in ("link_3_tip", "link_7_tip", "link_15_tip")
+                }
+                in_obj = {k: (np.linalg.inv(ob) @ np.append(p, 1.0))[:3] for k, p in tips_w.items()}
+                if st["phase"] == "released" and "tips0" not in st:
+                    st["tips0"] = in_obj
+                slip = " ".join(
+                    f"{k[5:-4]}={np.linalg.norm(in_obj[k] - st['tips0'][k]) * 1e3:5.1f}"
+                    for k in in_obj
+                    if "tips0" in st
+                )
+                ks = list(tips_w)
+                dist = " ".join(
+                    f"{np.linalg.norm(tips_w[ks[i]] - tips_w[ks[j]]) * 1e3:5.1f}"
+                    for i, j in ((0, 1), (0, 2), (1, 2))
+                )
+                hg = rob.gripper("hand")
+                used = [0, 1, 2, 3, 4, 5, 6, 7, 12, 13, 14, 15]
+                err = np.abs(rob.joint_positions()[used] - np.asarray(hg._targets)[used])
+                rows.append(
+                    f"      slip_mm: {slip}  tip_dist_mm(i-m,i-t,m-t): {dist}  "
+                    f"max|q-q_target|={err.max():.3f} rad (joint {used[int(err.argmax())]})"
+                )
             if args.normals:
+                tw = {
+                    k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3]
+                    for k in ("link_3_tip", "link_7_tip", "link_15_tip")
+                }
+                g = np.mean(list(tw.values()), axis=0)
                 for k in sorted(nrm):
                     n = nrm[k] / max(np.linalg.norm(nrm[k]), 1e-12)
+                    # the squeeze direction (towards the fingertip centroid) against the contact
+                    # normal: outside the friction cone (45 deg at mu = 1) the squeeze slides
+                    sq = palm[:3, :3].T @ (g - tw[k])
+                    ang = np.degrees(np.arccos(np.clip(n @ sq / np.linalg.norm(sq), -1.0, 1.0)))
                     rows.append(
-                        f"      {k}: normal(palm)=({n[0]:5.2f},{n[1]:5.2f},{n[2]:5.2f}) pen={pen[k] * 1e3:5.2f} mm"
+                        f"      {k}: normal(palm)=({n[0]:5.2f},{n[1]:5.2f},{n[2]:5.2f}) "
+                        f"pen={pen[k] * 1e3:5.2f} mm squeeze-normal angle={ang:5.1f} deg"
                     )
 
         be.add_body, be.detach, be.step = add_body_w, detach_w, step_w

@@ -287,3 +287,49 @@ def test_opt_in_solvers_from_the_warm_start(hand, tasks, solver):
     r = plan(hand, p, "relaxed-rigidity", IngraspConfig(solver=solver))
     assert r.pos_error < 1.0e-3
     assert _tip_distance_change(hand, p, r.q) < 2.0e-4
+
+
+def test_tip_rotation_against_the_object(hand, tasks):
+    """``tip_rotation_deg`` is the angle of each fingertip's rotation relative to the fingertip
+    triangle between the first and last waypoint: zero for an unchanged grasp, and equal to the
+    angle computed independently (scipy rotations of the FK frames) for a real plan."""
+    from scipy.spatial.transform import Rotation
+
+    from benchharness.strategies.ingrasp.planner import carrier_frames, tip_rotation_deg
+
+    task = tasks[0]  # apple-01
+    problem = problem_from_task(task, hand)
+    res = plan(hand, problem, "relaxed-rigidity", IngraspConfig())
+    np.testing.assert_allclose(
+        tip_rotation_deg(hand, problem.fingers, res.q[[0, 0]]), 0.0, atol=1e-6
+    )
+    x = hand.tip_poses_np(res.q[[0, -1]], problem.fingers)
+    c = carrier_frames(torch.as_tensor(x, dtype=DTYPE), "fingertips").numpy()
+    want = [
+        np.degrees(
+            (
+                Rotation.from_matrix((np.linalg.inv(c[0]) @ x[0, i])[:3, :3]).inv()
+                * Rotation.from_matrix((np.linalg.inv(c[1]) @ x[1, i])[:3, :3])
+            ).magnitude()
+        )
+        for i in range(len(problem.fingers))
+    ]
+    got = tip_rotation_deg(hand, problem.fingers, res.q)
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    assert max(got) > 20.0  # apple-01: index and middle turn ~38 deg against the apple
+
+
+def test_relaxed_rigidity_and_point_contact_turn_the_fingertips_alike(hand, tasks):
+    """Both hold the fingertip centres on the object and leave their orientation free, so on a
+    reachable task they plan the same fingertip rotation against the object (apple-01: 38.7 / 37.0
+    / 11.0 deg), while ik-rigid, which holds the orientation, turns them far less
+    (docs/ingrasp.md, "Execution drops")."""
+    from benchharness.strategies.ingrasp.planner import tip_rotation_deg
+
+    problem = problem_from_task(tasks[0], hand)  # apple-01
+    rot = {
+        v: tip_rotation_deg(hand, problem.fingers, plan(hand, problem, v, IngraspConfig()).q)
+        for v in ("relaxed-rigidity", "point-contact", "ik-rigid")
+    }
+    np.testing.assert_allclose(rot["relaxed-rigidity"], rot["point-contact"], atol=0.5)
+    assert np.max(rot["ik-rigid"]) < 0.5 * np.max(rot["relaxed-rigidity"])

@@ -491,6 +491,27 @@ def test_pinch_torsional_friction_is_a_pad_patch(make):
     assert analytic / 2 < torque < 2 * analytic
 
 
+@pytest.mark.parametrize("box_mu, ground_mu", [(1.0, 1.0), (0.5, 1.0), (0.3, 0.6)])
+def test_pair_friction_is_what_the_engine_simulates(make, box_mu: float, ground_mu: float):
+    """``pair_friction`` is the coefficient a sliding contact decelerates with: a box sliding on the
+    ground slows at ``mu g`` (analytic, Coulomb), ``mu = pair_friction(box, ground)``."""
+    backend = make()
+    mu = backend.pair_friction(box_mu, ground_mu)
+    assert backend.pair_friction(ground_mu, box_mu) == pytest.approx(mu)
+    backend.add_ground(friction=ground_mu)
+    box = backend.add_body([Box((0.05, 0.05, 0.05))], Pose([0, 0, 0.05]), 1.0, friction=box_mu)
+    backend.step(int(0.2 / backend.config.timestep))  # settle on the ground
+    v0 = 1.0
+    backend.set_velocity(box, [v0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    x0 = backend.get_pose(box).p[0]
+    n = int(0.05 / backend.config.timestep)
+    backend.step(n)
+    decel = (v0 - backend.get_velocity(box)[0][0]) / (n * backend.config.timestep)
+    assert backend.get_velocity(box)[0][0] > 0.2  # still sliding
+    assert backend.get_pose(box).p[0] > x0
+    assert decel == pytest.approx(mu * G, rel=0.1)
+
+
 def test_attach_detach(backend: Backend):
     """An attached box stays put (< 1 mm in 1 s) at the requested relative pose; detached, it falls."""
     backend.add_ground()

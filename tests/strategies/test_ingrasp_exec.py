@@ -8,6 +8,8 @@ then holds the object.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import torch
@@ -276,6 +278,87 @@ def test_placement_squeeze_inside_friction_cone(task_id):
     assert new.max_gap < 5e-4 and new.penetration <= 5e-4
     assert np.all(new.grip_angles_deg <= 45.0), new.grip_angles_deg
     assert np.max(old.grip_angles_deg) > 45.0, old.grip_angles_deg
+
+
+@pytest.mark.parametrize(
+    "backend, object_mu, pair_mu", [("pybullet", 0.5, 0.5), ("sapien", 0.5, 0.75)]
+)
+def test_placement_cone_follows_the_contact_friction(backend, object_mu, pair_mu):
+    """The default cone is atan(mu) of the fingertip-object contact as the engine combines it
+    (Bullet: product, PhysX: mean, with the hand links' 1.0); a number or None overrides it."""
+    hand = _shared_hand()
+    be = get_manager().create("backend", backend)
+    try:
+        ex = InGraspExecutor(hand, ExecConfig(object_friction=object_mu))
+        assert ex.contact_friction(be) == pytest.approx(pair_mu)
+        assert ex.grip_cone_deg(ex.contact_friction(be)) == pytest.approx(
+            math.degrees(math.atan(pair_mu))
+        )
+        assert (
+            InGraspExecutor(hand).grip_cone_deg(InGraspExecutor(hand).contact_friction(be)) == 45.0
+        )
+    finally:
+        be.close()
+    assert (
+        InGraspExecutor(hand, ExecConfig(placement_grip_cone_deg=30.0)).grip_cone_deg(2.0) == 30.0
+    )
+    assert (
+        InGraspExecutor(hand, ExecConfig(placement_grip_cone_deg=None)).grip_cone_deg(2.0) is None
+    )
+    with pytest.raises(ValueError):
+        ExecConfig(placement_grip_cone_deg="mu")  # type: ignore[arg-type]
+
+
+def test_placement_widens_with_friction():
+    """banana-06's contacts-only placement squeezes 62 / 63 / 37 deg off the normals: outside the
+    45 deg cone of mu = 1 (so the placement moves), inside the 63.4 deg cone of mu = 2 (so it stays)."""
+    t = {x.task_id: x for x in published_tasks()}["banana-06"]
+    planner = InGraspPlanner("relaxed-rigidity")
+    problem = planner.problem(t)
+    ex = InGraspExecutor(planner.hand)
+    old = InGraspExecutor(planner.hand, ExecConfig(placement_grip_cone_deg=None)).placement(
+        problem, t.object
+    )
+    mu1, mu2 = ex.placement(problem, t.object, 1.0), ex.placement(problem, t.object, 2.0)
+    assert np.all(mu1.grip_angles_deg <= 45.0) and np.max(old.grip_angles_deg) > 45.0
+    assert np.all(old.grip_angles_deg <= math.degrees(math.atan(2.0)))
+    np.testing.assert_array_equal(mu2.pose, old.pose)
+
+
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+def test_gravity_compensation_carries_the_fingers(backend, task):
+    """Palm up and free, the fingers held at a grasp under plain PD settle where the spring carries
+    the fingers' weight, K (q0 - q) = tau_g(q) (static equilibrium); with the target shifted by
+    tau_g / K every control period they hold the grasp. The engine's inverse dynamics
+    (``finger_gravity``) is the only model of the weight used."""
+    from benchharness.geometry import Pose
+    from benchharness.strategies.ingrasp.execution import PALM_ROTATIONS, finger_gravity
+
+    m = get_manager()
+    q0 = InGraspPlanner("relaxed-rigidity").problem(task).q_rest
+    errs, tau_end = {}, {}
+    for comp in (False, True):
+        be = m.create("backend", backend)
+        try:
+            robot = m.create("robot", "allegro")
+            robot.spawn(be, Pose.from_rotation([0.0, 0.0, 0.4], PALM_ROTATIONS["up"]), q=q0)
+            hand = robot.gripper("hand")
+            kp = np.asarray(hand.config.stiffness, float)
+            for _ in range(120):  # 1 s, targets re-sent every 1/120 s as the executor does
+                tau = finger_gravity(be, robot, hand.joints)
+                hand.set_command(q0 + tau / kp if comp else q0)
+                be.step(max(1, int(round(1 / 120 / be.config.timestep))))
+            errs[comp] = robot.joint_positions()[:16] - q0
+            tau_end[comp] = finger_gravity(be, robot, hand.joints)
+        finally:
+            be.close()
+    sag = -tau_end[False] / kp  # plain PD at rest: K (q0 - q) = tau_g(q)
+    # palm up, the index and middle proximal joints (1, 5) carry their fingers horizontally:
+    # measured ~0.017 rad of sag on both engines, the largest gravity load of the hand
+    loaded = [1, 5]
+    assert np.all(np.abs(sag[loaded]) > 0.01), sag
+    np.testing.assert_allclose(errs[False][loaded], sag[loaded], rtol=0.15)
+    assert np.all(np.abs(errs[True][loaded]) < 0.1 * np.abs(sag[loaded])), errs[True]
 
 
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])

@@ -355,6 +355,15 @@ class Backend(abc.ABC):
         except KeyError:
             raise BackendError(f"no step callback with handle {handle}") from None
 
+    @abc.abstractmethod
+    def pair_friction(self, a: float, b: float) -> float:
+        """The Coulomb coefficient this engine gives a contact between bodies of friction ``a`` and ``b``.
+
+        Engines combine the two bodies' coefficients differently (docs/backends.md, "Friction
+        combination"): Bullet multiplies them, PhysX averages them. URDF links get
+        :attr:`PhysicsConfig.default_friction`, a body its ``friction`` (or the default).
+        """
+
     # -- bodies --------------------------------------------------------------
     @abc.abstractmethod
     def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:

@@ -408,6 +408,10 @@ class PyBulletBackend(Backend):
         """
         return 0.5 * float(self.config.torsional_friction) * float(friction)
 
+    def pair_friction(self, a: float, b: float) -> float:
+        """Bullet's combined friction of a contact: the product of the two bodies' coefficients."""
+        return float(a) * float(b)
+
     # -- bodies ----------------------------------------------------------------
     def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
         cid = self._cid

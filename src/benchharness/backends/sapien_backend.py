@@ -247,6 +247,10 @@ class SapienBackend(Backend):
             f"{self._steps} (t = {self.time:.4f} s): the simulation blew up"
         )
 
+    def pair_friction(self, a: float, b: float) -> float:
+        """PhysX's combined friction of a contact: the mean of the two materials' (default combine mode)."""
+        return 0.5 * (float(a) + float(b))
+
     # -- bodies ----------------------------------------------------------------
     def add_ground(self, height: float = 0.0, friction: float | None = None) -> BodyId:
         self._apply_global_config()

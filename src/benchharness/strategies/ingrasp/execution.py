@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import torch
@@ -68,7 +68,14 @@ from .planner import PlanResult
 from .problem import InGraspProblem
 from .rotations import pose_vector
 
-__all__ = ["ExecConfig", "ExecResult", "InGraspExecutor", "squeeze_offsets", "PALM_ROTATIONS"]
+__all__ = [
+    "ExecConfig",
+    "ExecResult",
+    "InGraspExecutor",
+    "squeeze_offsets",
+    "finger_gravity",
+    "PALM_ROTATIONS",
+]
 
 #: Palm frame (``palm_link``: fingers along +z, palm facing +x) in the world, per ``ExecConfig.palm``.
 PALM_ROTATIONS = {
@@ -111,9 +118,18 @@ class ExecConfig:
         True  #: reached = executed displacement applied to H_i (paper's set-up correction)
     )
     max_placement_gap: float = 0.002  #: m, placement fit worse than this is refused (unreachable)
-    #: deg, friction cone half angle the set-up placement keeps the squeeze directions inside
-    #: (``placement.place_object``; 45 = atan of the default friction 1.0); None: contacts only
-    placement_grip_cone_deg: float | None = 45.0
+    #: friction cone half angle (deg) the set-up placement keeps the squeeze directions inside
+    #: (``placement.place_object``). ``"friction"`` (default): ``atan(mu)`` of the fingertip-object
+    #: contact's coefficient as the engine combines it (:meth:`Backend.pair_friction` of the object's
+    #: friction and the hand links' ``PhysicsConfig.default_friction``; 45 deg at the defaults, 1.0);
+    #: a number: that angle whatever the friction; None: contacts only (before 2026-12-02)
+    placement_grip_cone_deg: float | Literal["friction"] | None = "friction"
+    #: add the fingers' gravity holding torques (the engine's inverse dynamics at the measured joints,
+    #: every control period) to the joint targets, as ``tau_g / K``: the PD spring's torque then goes
+    #: into the squeeze instead of carrying the fingers (palm up the proximal joints of index and
+    #: middle carry ~0.05 N m of finger weight against a ~0.13 N m squeeze). False: plain PD (before
+    #: 2026-12-02). docs/ingrasp.md, "Execution drops"
+    gravity_compensation: bool = True
 
     def __post_init__(self) -> None:
         if self.palm not in PALM_ROTATIONS:
@@ -135,6 +151,14 @@ class ExecConfig:
                 raise ValueError(f"{name} must be >= 0")
         if self.object_friction is not None and self.object_friction < 0:
             raise ValueError("object_friction must be >= 0")
+        cone = self.placement_grip_cone_deg
+        if isinstance(cone, str):
+            if cone != "friction":
+                raise ValueError(
+                    f"placement_grip_cone_deg must be a number, 'friction' or None, not {cone!r}"
+                )
+        elif cone is not None and not 0.0 <= float(cone) <= 90.0:
+            raise ValueError("placement_grip_cone_deg must be in [0, 90] deg")
 
 
 @dataclass
@@ -195,6 +219,17 @@ def backoff_offsets(
     return np.concatenate([np.linalg.pinv(jac[i]) @ (distance * d[i]) for i in range(len(fingers))])
 
 
+def finger_gravity(backend, robot, joints) -> np.ndarray:
+    """Gravity holding torques (N m) of ``joints`` of ``robot`` at its measured configuration.
+
+    The engine's own inverse dynamics (``Backend.gravity_torques``). Added to a PD drive's torque
+    (as a target shift ``tau / K``) it carries the fingers' weight, as the authors' Allegro PD node
+    does (joint PD plus KDL gravity compensation); the spring's torque is then the contact force's.
+    """
+    tau = np.asarray(backend.gravity_torques(robot.body), float)
+    return tau[robot.joint_index(list(joints))]
+
+
 def _mat(pose) -> np.ndarray:
     return pose.as_matrix()
 
@@ -213,15 +248,37 @@ class InGraspExecutor:
         self.config = config or ExecConfig()
 
     # ----------------------------------------------------------------- set-up geometry
-    def placement(self, problem: InGraspProblem, object_name: str) -> InGraspPlacement:
-        """Where the (noise-free) object sits at ``q_0``; cached per task and object."""
+    def grip_cone_deg(self, friction: float) -> float | None:
+        """The placement's friction cone half angle (deg) for a contact friction coefficient ``friction``.
+
+        ``atan(mu)`` with :attr:`ExecConfig.placement_grip_cone_deg` ``"friction"``; the configured
+        angle otherwise (None: no cone).
+        """
+        cone = self.config.placement_grip_cone_deg
+        if cone == "friction":
+            return float(np.degrees(np.arctan(float(friction))))
+        return None if cone is None else float(cone)
+
+    def contact_friction(self, backend) -> float:
+        """The fingertip-object friction coefficient in ``backend``: the engine's combination of the
+        object's (:attr:`ExecConfig.object_friction`, else the physics default) and the hand links'
+        (the physics default)."""
+        hand_mu = float(backend.config.default_friction)
+        obj_mu = hand_mu if self.config.object_friction is None else self.config.object_friction
+        return float(backend.pair_friction(obj_mu, hand_mu))
+
+    def placement(
+        self, problem: InGraspProblem, object_name: str, friction: float = 1.0
+    ) -> InGraspPlacement:
+        """Where the (noise-free) object sits at ``q_0`` for a contact friction ``friction``; cached
+        per task, object and friction cone."""
         return _cached_placement(
             self.hand,
             problem.task_id,
             object_name,
             tuple(np.round(problem.q_rest, 12)),
             problem.fingers,
-            self.config.placement_grip_cone_deg,
+            self.grip_cone_deg(friction),
         )
 
     # ----------------------------------------------------------------- the trial
@@ -253,7 +310,8 @@ class InGraspExecutor:
                 f"got {getattr(robot, 'name', robot)!r}"
             )
         wall0 = time.perf_counter()
-        place = self.placement(problem, object_name)
+        mu = self.contact_friction(backend)
+        place = self.placement(problem, object_name, mu)
         if place.max_gap > cfg.max_placement_gap:
             raise ValueError(
                 f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
@@ -313,6 +371,8 @@ class InGraspExecutor:
             "placement_penetration_mm": round(place.penetration * 1e3, 3),
             "placement_rotation_change_deg": round(place.rotation_change_deg, 3),
             "placement_grip_angles_deg": np.round(place.grip_angles_deg, 1).tolist(),
+            "contact_friction": round(mu, 6),
+            "placement_grip_cone_deg": self.grip_cone_deg(mu),
             "setup_noise_pos_mm": (dp * 1e3).round(4).tolist(),
             "setup_noise_rot_deg": round(
                 float(np.degrees(Rotation.from_matrix(dr).magnitude())), 4
@@ -369,11 +429,22 @@ class InGraspExecutor:
                     f"({state['com_dist'] * 100:.1f} cm at the grasp)"
                 )
 
+        grav = cfg.gravity_compensation and backend.capabilities.gravity_torques
+        cap = np.asarray(hand_grip.config.force_limit, float)
+
+        def command(q: np.ndarray) -> None:
+            """Joint targets ``q``; with gravity compensation shifted by ``tau_g / K`` (cap + |tau_g|)."""
+            if not grav:
+                hand_grip.set_command(q)
+                return
+            tau = finger_gravity(backend, robot, hand_grip.joints)
+            hand_grip.set_command(q + tau / kp, force_limit=cap + np.abs(tau))
+
         def run_for(seconds: float, target_fn, active: bool) -> None:
             n = max(1, int(round(seconds / (per * backend.config.timestep))))
             t0 = float(backend.time)
             for k in range(n):
-                hand_grip.set_command(target_fn(float(backend.time) - t0))
+                command(target_fn(float(backend.time) - t0))
                 backend.step(per)
                 if float(backend.time) - state["checked"] >= cfg.check_period - 1e-9 or k == n - 1:
                     state["checked"] = float(backend.time)
@@ -404,6 +475,11 @@ class InGraspExecutor:
                 if any(c.link_b == lk for c in backend.contacts(obj, robot.body))
             ]
             extra["setup_tip_contacts"] = sorted(tips_setup)
+            forces = {lk: 0.0 for lk in sorted(tip_links)}
+            for c in backend.contacts(obj, robot.body):
+                if c.link_b in forces:
+                    forces[c.link_b] += float(c.normal_force)
+            extra["setup_tip_forces_n"] = {k: round(v, 4) for k, v in forces.items()}
             extra["setup_joint_error_rad"] = round(
                 float(np.max(np.abs(robot.joint_positions()[idx] - q0[idx]))), 5
             )

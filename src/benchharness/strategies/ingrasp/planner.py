@@ -113,6 +113,24 @@ def object_poses(
     return carrier_frames(hand.tip_poses(q, problem.fingers), object_frame) @ attach
 
 
+def tip_rotation_deg(hand: HandKinematics, fingers: tuple[str, ...], q: np.ndarray) -> np.ndarray:
+    """How far each fingertip turns against the object over a plan (deg, one per finger).
+
+    The object is taken to move with the fingertip triangle (the ``"fingertips"`` carrier, as the
+    relaxed variants plan it): the angle is that of the fingertip's rotation relative to the
+    carrier frame between the first and the last row of ``q`` (T + 1, 4 k). A rigid fingertip
+    sphere of radius r whose centre the plan holds on the object can only turn that much by
+    rolling (its centre then moves r x angle over the object) or by sliding: the relaxed
+    variants leave this angle free (docs/ingrasp.md, "Execution drops").
+    """
+    x = torch.as_tensor(hand.tip_poses_np(np.asarray(q, float)[[0, -1]], fingers), dtype=DTYPE)
+    rel = inverse(carrier_frames(x, "fingertips"))[:, None] @ x  # (2, k, 4, 4)
+    r = (rel[0, :, :3, :3].transpose(-1, -2) @ rel[1, :, :3, :3]).numpy()
+    cos = (np.trace(r, axis1=-2, axis2=-1) - 1.0) / 2.0
+    w = np.stack([r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], -1)
+    return np.degrees(np.arctan2(np.linalg.norm(w, axis=-1) / 2.0, cos))  # exact near 0 and pi
+
+
 def project_trajectory(
     q: np.ndarray, q0: np.ndarray, lower: np.ndarray, upper: np.ndarray, max_step: float
 ) -> np.ndarray:

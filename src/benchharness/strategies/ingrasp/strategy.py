@@ -14,7 +14,7 @@ from pathlib import Path
 from .config import VARIANTS, IngraspConfig
 from .execution import ExecConfig, InGraspExecutor
 from .hand import HandKinematics
-from .planner import PlanResult, plan
+from .planner import PlanResult, plan, tip_rotation_deg
 from .problem import InGraspProblem, problem_from_task
 from .tasks import InGraspTask, published_tasks
 
@@ -115,6 +115,10 @@ class InGraspPlanner:
             "planned_reached": np.round(res.reached, 7).tolist(),
             "plan_pos_error_cm": round(res.pos_error * 100, 5),
             "plan_converged": res.converged,
+            # per used finger: how far the plan turns the fingertip against the object (rolls it)
+            "plan_tip_rotation_deg": np.round(
+                tip_rotation_deg(self.hand, problem.fingers, res.q), 2
+            ).tolist(),
         }
         executor = InGraspExecutor(self.hand, self.exec_config)
         try:
