@@ -122,6 +122,12 @@ def test_the_builtin_strategies_are_built_with_the_options():
     kw, canon = apply_options(ig.options(), [("exec_config.hold_s", "2"), ("waypoints", "8")])
     assert kw["exec_config"].hold_s == 2.0 and kw["config"].waypoints == 8
     assert canon == (("exec_config.hold_s", "2.0"), ("waypoints", "8"))
+    # float | Literal["friction"] | None: each spelling reads as its own type
+    for raw, value in (("30", 30.0), ("friction", "friction"), ("none", None)):
+        kw, _ = apply_options(ig.options(), [("exec_config.placement_grip_cone_deg", raw)])
+        assert kw["exec_config"].placement_grip_cone_deg == value
+    with pytest.raises(OptionError, match="not a number / not one of friction"):
+        apply_options(ig.options(), [("exec_config.placement_grip_cone_deg", "wide")])
 
 
 def test_field_docs_are_the_hash_colon_comments_through_the_bases():

@@ -104,7 +104,20 @@ def _convert(raw: str, tp: Any, key: str) -> Any:
             return None
         if len(rest) == 1:
             return _convert(raw, rest[0], key)
-        raise OptionError(f"--strategy-option {key}: its type {tp} cannot be set from text")
+        # several types (``float | Literal["friction"]``): the first that reads the text, text last
+        errors = []
+        for a in sorted(rest, key=lambda a: a is str):
+            try:
+                return _convert(raw, a, key)
+            except OptionError as exc:
+                errors.append(str(exc).split(": ", 1)[-1])
+        raise OptionError(f"--strategy-option {key}={raw}: {' / '.join(errors)}")
+    if origin is typing.Literal:
+        for a in args:
+            if str(a) == raw.strip():
+                return a
+        choices = ", ".join(str(a) for a in args)
+        raise OptionError(f"--strategy-option {key}={raw}: not one of {choices}")
     if origin is tuple:
         parts = [p.strip() for p in raw.split(",")] if raw.strip() else []
         if len(args) == 2 and args[1] is Ellipsis:
@@ -270,6 +283,20 @@ def field_docs(cls: type) -> dict[str, str]:
     return docs
 
 
+def _label(tp: Any) -> str:
+    """An annotation as a person writes it: ``float | 'friction' | None``, ``tuple[float, ...]``."""
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if tp is type(None):
+        return "None"
+    if origin in (typing.Union, types.UnionType):
+        return " | ".join(_label(a) for a in args)
+    if origin is typing.Literal:
+        return " | ".join(repr(a) for a in args)
+    if origin is tuple:
+        return "tuple[" + ", ".join("..." if a is Ellipsis else _label(a) for a in args) + "]"
+    return tp.__name__ if isinstance(tp, type) else str(tp).replace("typing.", "")
+
+
 def describe_options(defaults: Mapping[str, Any]) -> list[tuple[str, str, str, str]]:
     """Every settable key in declaration order: (key, type, default, its ``#:`` comment)."""
     rows: list[tuple[str, str, str, str]] = []
@@ -283,9 +310,7 @@ def describe_options(defaults: Mapping[str, Any]) -> list[tuple[str, str, str, s
             if _is_config(value):
                 walk(value, f"{prefix}{name}.")
                 continue
-            tp = hints[name]
-            label = tp.__name__ if isinstance(tp, type) else str(tp).replace("typing.", "")
-            rows.append((f"{prefix}{name}", label, _fmt(value), docs.get(name, "")))
+            rows.append((f"{prefix}{name}", _label(hints[name]), _fmt(value), docs.get(name, "")))
 
     for kw, obj in defaults.items():
         walk(obj, "" if kw == first else f"{kw}.")
