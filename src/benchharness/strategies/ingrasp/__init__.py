@@ -12,9 +12,8 @@ FK), :mod:`.rotations`, :mod:`.tasks` (published Level I tasks),
 optimiser), :mod:`.strategy` (the plugin object: ``plan_task`` and the
 runner's ``run_trial``), :mod:`.placement` (where our object model sits in
 the initial grasp), :mod:`.execution` (a simulated trial: set-up, execution,
-5 s stability check, drops), :mod:`.results` (results files),
-:mod:`.stiff_plugin` (opt-in ``relaxed-rigidity-stiff``). Importing this
-package is cheap: torch loads in the factories.
+5 s stability check, drops), :mod:`.results` (results files). Importing this package is cheap: torch
+loads in the factories.
 """
 
 from __future__ import annotations
