@@ -93,6 +93,11 @@ class Hand:
     log: list = field(default_factory=list)
 
 
+def _shifted(pose: Pose, shift: np.ndarray) -> Pose:
+    """``pose`` translated by ``shift`` (m, world)."""
+    return Pose(pose.p + shift, pose.q)
+
+
 @dataclass(frozen=True)
 class GripRequest:
     """What the machine asks of a grasp module's grip.
@@ -499,6 +504,12 @@ class BimanualRubiksMachine:
         )
         return np.asarray(res.q[0], dtype=float) if ok else None
 
+    def _turn_shift(self) -> np.ndarray:
+        """How far a hand-over turn carries the believed cube centre besides turning it (``recentre_turn``)."""
+        if not self.config.recentre_turn:
+            return np.zeros(3)
+        return np.asarray(self.config.twist_position, dtype=float) - self.est.p
+
     def turn_travel(
         self,
         hand: Hand,
@@ -543,7 +554,11 @@ class BimanualRubiksMachine:
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
-            poses = [rotate_about_point(grips[k], self.est.p, axis, angle * i / n) for k in live]
+            shift = self._turn_shift() * (i / n)
+            poses = [
+                _shifted(rotate_about_point(grips[k], self.est.p, axis, angle * i / n), shift)
+                for k in live
+            ]
             if back > 0:  # the retreat
                 poses = [self.back_off(p, back) for p in poses]
             targets = [(base.inv() * p).as_matrix() for p in poses]
@@ -1271,12 +1286,13 @@ class BimanualRubiksMachine:
             )
         self.release_hand(taker, retreat=cfg.taker_retreat)
         centre = self.est.p.copy()
+        shift = self._turn_shift()
         n = max(1, cfg.handover_waypoints) * abs(a.quarter_turns)
         start = giver.cmd
         for i in range(1, n + 1):
             self.send(
                 giver,
-                rotate_about_point(start, centre, a.axis, angle * i / n),
+                _shifted(rotate_about_point(start, centre, a.axis, angle * i / n), shift * (i / n)),
                 label="hand-over turn",
                 settle=0.05 if i < n else 0.2,
             )
