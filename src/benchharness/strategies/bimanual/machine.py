@@ -118,6 +118,9 @@ class GripRequest:
     on_table: bool = False  #: the cube is on the table: no finger may go under it
     relation: str | None = None
     take: bool = False  #: a hand-over's take (the other hand is the giver)
+    twist_now: bool = (
+        False  #: the hand twists right after this grip (the rotator's re-grip before a twist)
+    )
 
 
 class GraspModule(Protocol):
@@ -1073,6 +1076,7 @@ class BimanualRubiksMachine:
         take: bool = False,
         twist_delta: float | None = None,
         give_turn: tuple[str, float] | None = None,
+        twist_now: bool = False,
     ) -> None:
         """``hand`` grips the cube from ``world_dir``, ``depth`` slabs deep: choose, swing to the stand-off,
         move in and close (the last by the grasp module), then the bookkeeping.
@@ -1090,7 +1094,9 @@ class BimanualRubiksMachine:
             turn = give_turn
         if twist_delta is None:
             twist_delta = self._next_twist_delta(k, hand.side) if depth == 1 else 0.0
-        req = GripRequest(world_dir, depth, label, turn, twist_delta, on_table, relation, take)
+        req = GripRequest(
+            world_dir, depth, label, turn, twist_delta, on_table, relation, take, twist_now
+        )
         grasp = self.grasp
         pose, q_plan = grasp.choose(self, hand, req)
         grasp.ready(self, hand, req)
@@ -1188,7 +1194,7 @@ class BimanualRubiksMachine:
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             # after a twist the rotator stands off: a twist right after a twist re-takes its slab
             if hold.holding and hold.depth == 2 and not rot.holding:
-                self.grip(rot, SIDE_DIR[rot.side], 1, "re-grip", twist_delta=delta)
+                self.grip(rot, SIDE_DIR[rot.side], 1, "re-grip", twist_delta=delta, twist_now=True)
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             raise StrategyFailure(None, f"twist {k + 1}: hands not in twisting grips")
         move = twist_move(orientation, t.axis, t.layer, t.quarter_turns)

@@ -156,7 +156,8 @@ class PushGrasp:
         carry that turn and the retreat after it without an IK flip
         (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`); if no grip does, one whose
         turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not).
-        Returns no IK solution: the arm moves to the stand-off from where it is.
+        Returns the IK solution to reach the grip by when the wrist had to be re-seeded for the twist
+        (see below), else None: the arm moves to the stand-off from where it is.
         """
         cfg = self.config
         st = _st(hand)
@@ -173,96 +174,123 @@ class PushGrasp:
         base = hand.arm.base_pose()
         q_now = hand.arm.positions()
         lo, hi = hand.arm.lower[-1], hand.arm.upper[-1]
-        best: Pose | None = None
-        second: Pose | None = (
-            None  # a giver's grip whose turn is smooth but not the retreat after it
-        )
-        fallback: Pose | None = None
-        best_score = second_score = fallback_score = -np.inf
-        best_slide = second_slide = fallback_slide = 0.0
-        # diagnostic for the recorder: each candidate and why it was taken or not
-        tried: list[str] = []
-        lateral = cfg.holder_thumb_offset if st.shape == 2 else cfg.rotator_thumb_offset
-        for pose in push_grip_candidates(m.est, world_dir, st.face_depth):
-            fx = pinch_axis(pose)
-            tag = f"pinch {_axis_name(fx)} thumb {_axis_name(pose.rotation.apply([0.0, 1.0, 0.0]))}"
-            shift: float | None = lateral
-            if other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7:
-                # both hands on the same faces
-                shift = self._clear_lateral(m, hand, pose, lateral)
-                if shift is None:
-                    tried.append(f"{tag}: fingers cannot clear the other hand's")
-                    continue
-                if abs(shift - lateral) > 1e-4:
-                    tag += f" slid {1000 * (shift - lateral):+.0f} mm"
-            assert shift is not None
-            pose = Pose(pose.p + pose.rotation.apply([0.0, shift, 0.0]), pose.q)
-            if req.on_table and (
-                abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7
-            ):
-                # on the table: no outer finger under the cube, and the thumb's root below (its tip
-                # curls up onto the face, clear of the table top)
-                continue
-            crossing = other_x is None or abs(float(np.dot(fx, other_x))) < 0.3
-            if other_on_axis and other_z is not None:
-                crossing = crossing and abs(float(np.dot(fx, other_z))) < 0.3
-            if perpendicular and not crossing:
-                tried.append(f"{tag}: not crossing")
-                continue
-            if parallel and (other_x is None or abs(float(np.dot(fx, other_x))) < 0.7):
-                tried.append(f"{tag}: not parallel")
-                continue
-            res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q_now)
-            if not res.success[0]:
-                tried.append(f"{tag}: no IK")
-                continue
-            q7 = float(res.q[0][-1])
-            margin = min(q7 - lo, hi - q7, q7 + twist_delta - lo, hi - (q7 + twist_delta))
-            joint_move = float(np.max(np.abs(res.q[0] - q_now)))
-            score = min(margin, 0.3) - 0.1 * joint_move + (0.5 if crossing else 0.0)
-            if margin < 0.0:
-                score -= 10.0
-            if turn is not None:
-                # the giver's pinch must not end on the work axis after the turn: its fingertip would sit
-                # on the face the taker's thumb comes to, and the taker's push would meet the finger
-                turned = Rotation.from_rotvec(DIRECTIONS[turn[0]] * turn[1])
-                if abs(float(turned.apply(fx)[1])) > 0.7:
-                    tried.append(f"{tag}: pinch on the work axis after the turn")
-                    continue
-                # and its thumb, curled over the face it pushed, should rise towards its root on the side
-                # away from the taker (a preference: with the root on the taker's side, the giver's fingers,
-                # 12 mm off centre towards the root, are where the taker's fingertips close)
-                taker_dir = DIRECTIONS[SIDE_DIR[other.side]]
-                if (
-                    float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir))
-                    > -0.7
-                ):
-                    score -= 1.0
-                if score > fallback_score:
-                    fallback, fallback_score, fallback_slide = pose, score, shift - lateral
-                travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
-                if not np.isfinite(travel[0]):
-                    # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
-                    # turn alone is smooth is the second choice (the retreat is then cut short)
-                    short, _ = m.turn_travel(
-                        hand, base, [pose], res.q[:1], *turn, with_retreat=False
-                    )
-                    tried.append(
-                        f"{tag}: turn + retreat not smooth (score {score:.2f}; largest joint step "
-                        f"{float(worst[0]):.2f} rad; turn alone "
-                        f"{'smooth' if np.isfinite(short[0]) else 'not smooth'})"
-                    )
-                    if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
-                        second = pose
-                        second_score = score - 0.1 * float(short[0])
-                        second_slide = shift - lateral
-                    continue
-                score -= 0.1 * float(travel[0])
-            tried.append(
-                f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})"
+        # a second pass, the wrist re-seeded, only when every grip of a rotator about to twist leaves
+        # the wrist short of the twist (earlier grips leave it to ``regrip_before_twist``: re-seeded
+        # there, arms took other branches and a later twist dragged, SAPIEN Rubiks-5-5 trial 4)
+        for reseed in (False, True):
+            best: Pose | None = None
+            second: Pose | None = (
+                None  # a giver's grip whose turn is smooth but not the retreat after it
             )
-            if score > best_score:
-                best, best_score, best_slide = pose, score, shift - lateral
+            fallback: Pose | None = None
+            best_score = second_score = fallback_score = -np.inf
+            best_slide = second_slide = fallback_slide = 0.0
+            best_q: np.ndarray | None = None  # the IK solution to reach ``best`` by, if re-seeded
+            # diagnostic for the recorder: each candidate and why it was taken or not
+            tried: list[str] = []
+            lateral = cfg.holder_thumb_offset if st.shape == 2 else cfg.rotator_thumb_offset
+            for pose in push_grip_candidates(m.est, world_dir, st.face_depth):
+                fx = pinch_axis(pose)
+                tag = f"pinch {_axis_name(fx)} thumb {_axis_name(pose.rotation.apply([0.0, 1.0, 0.0]))}"
+                shift: float | None = lateral
+                if other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7:
+                    # both hands on the same faces
+                    shift = self._clear_lateral(m, hand, pose, lateral)
+                    if shift is None:
+                        tried.append(f"{tag}: fingers cannot clear the other hand's")
+                        continue
+                    if abs(shift - lateral) > 1e-4:
+                        tag += f" slid {1000 * (shift - lateral):+.0f} mm"
+                assert shift is not None
+                pose = Pose(pose.p + pose.rotation.apply([0.0, shift, 0.0]), pose.q)
+                if req.on_table and (
+                    abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7
+                ):
+                    # on the table: no outer finger under the cube, and the thumb's root below (its tip
+                    # curls up onto the face, clear of the table top)
+                    continue
+                crossing = other_x is None or abs(float(np.dot(fx, other_x))) < 0.3
+                if other_on_axis and other_z is not None:
+                    crossing = crossing and abs(float(np.dot(fx, other_z))) < 0.3
+                if perpendicular and not crossing:
+                    tried.append(f"{tag}: not crossing")
+                    continue
+                if parallel and (other_x is None or abs(float(np.dot(fx, other_x))) < 0.7):
+                    tried.append(f"{tag}: not parallel")
+                    continue
+                res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q_now)
+                if not res.success[0]:
+                    tried.append(f"{tag}: no IK")
+                    continue
+                q7 = float(res.q[0][-1])
+                margin = min(q7 - lo, hi - q7, q7 + twist_delta - lo, hi - (q7 + twist_delta))
+                q_seeded: np.ndarray | None = None
+                if reseed and margin < 0.0 and np.isfinite(lo) and np.isfinite(hi):
+                    # seeded from where the arm is, IK spreads the grip's roll over the forearm and wrist
+                    # joints and leaves the wrist no room for the twist (measured: all four grips of a
+                    # half turn's re-grip 1.0-3.1 rad short, the wrist limited 177 deg short and F2 jammed,
+                    # SAPIEN and PyBullet Rubiks-5-5 trial 4); seeded with the wrist in the middle of the
+                    # twist's room, the arm's redundancy takes the roll instead
+                    seed = np.array(q_now, dtype=float)
+                    seed[-1] = 0.5 * (max(lo, lo - twist_delta) + min(hi, hi - twist_delta))
+                    alt = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
+                    if alt.success[0]:
+                        a7 = float(alt.q[0][-1])
+                        alt_margin = min(
+                            a7 - lo, hi - a7, a7 + twist_delta - lo, hi - (a7 + twist_delta)
+                        )
+                        if alt_margin > margin:
+                            res, q7, margin = alt, a7, alt_margin
+                            q_seeded = np.asarray(alt.q[0], dtype=float)
+                            tag += " (wrist re-seeded)"
+                joint_move = float(np.max(np.abs(res.q[0] - q_now)))
+                score = min(margin, 0.3) - 0.1 * joint_move + (0.5 if crossing else 0.0)
+                if margin < 0.0:
+                    score -= 10.0
+                if turn is not None:
+                    # the giver's pinch must not end on the work axis after the turn: its fingertip would sit
+                    # on the face the taker's thumb comes to, and the taker's push would meet the finger
+                    turned = Rotation.from_rotvec(DIRECTIONS[turn[0]] * turn[1])
+                    if abs(float(turned.apply(fx)[1])) > 0.7:
+                        tried.append(f"{tag}: pinch on the work axis after the turn")
+                        continue
+                    # and its thumb, curled over the face it pushed, should rise towards its root on the side
+                    # away from the taker (a preference: with the root on the taker's side, the giver's fingers,
+                    # 12 mm off centre towards the root, are where the taker's fingertips close)
+                    taker_dir = DIRECTIONS[SIDE_DIR[other.side]]
+                    if (
+                        float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir))
+                        > -0.7
+                    ):
+                        score -= 1.0
+                    if score > fallback_score:
+                        fallback, fallback_score, fallback_slide = pose, score, shift - lateral
+                    travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
+                    if not np.isfinite(travel[0]):
+                        # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
+                        # turn alone is smooth is the second choice (the retreat is then cut short)
+                        short, _ = m.turn_travel(
+                            hand, base, [pose], res.q[:1], *turn, with_retreat=False
+                        )
+                        tried.append(
+                            f"{tag}: turn + retreat not smooth (score {score:.2f}; largest joint step "
+                            f"{float(worst[0]):.2f} rad; turn alone "
+                            f"{'smooth' if np.isfinite(short[0]) else 'not smooth'})"
+                        )
+                        if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
+                            second = pose
+                            second_score = score - 0.1 * float(short[0])
+                            second_slide = shift - lateral
+                        continue
+                    score -= 0.1 * float(travel[0])
+                tried.append(
+                    f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})"
+                )
+                if score > best_score:
+                    best, best_score, best_slide = pose, score, shift - lateral
+                    best_q = q_seeded
+            if reseed or not req.twist_now or best is None or best_score > -5.0:
+                break
         if best is None and second is not None:
             m.ctx.recorder.event(
                 "warning",
@@ -288,7 +316,7 @@ class PushGrasp:
                 "unreachable", f"{hand.side} arm: no push-grasp from {world_dir} reachable"
             )
         st.slide = best_slide
-        return best, None
+        return best, best_q
 
     def _clear_lateral(
         self, m: BimanualRubiksMachine, hand: Hand, face_pose: Pose, nominal: float
