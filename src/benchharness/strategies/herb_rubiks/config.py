@@ -148,8 +148,10 @@ class HerbPushGraspConfig(BimanualConfig):
     lone_holder_two_slabs: bool = True
     #: a hand that closed on the cube held by the other hand centres its pinch across the pinch axis when the
     #: middle of its fingers' inner sides (FK of its joints) is farther than this off the tool frame (m;
-    #: None: never): it opens, moves across and closes again (docs/herb_push_grasp.md, "Centring the pinch").
-    centre_tolerance: float | None = 0.0015
+    #: None: never): it opens, moves across and closes again. Off: at 1.5 mm PyBullet's Rubiks-5-5 fell to
+    #: 1/5 (4/5 without): the FK offset after a re-centring was often no smaller (a held cube moves with the
+    #: re-closing fingers; overshoots of 1.6 -> 1.8 mm, 3.2 -> 4.2 mm), and each re-close shook the cube.
+    centre_tolerance: float | None = None
     #: the fingers' inner sides must be this close to the cube's width apart (m) to be read as its side faces.
     centre_width_tolerance: float = 0.006
     #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).
