@@ -93,6 +93,11 @@ class BimanualConfig:
     #: holding two slabs from its side meanwhile (:meth:`.machine.BimanualRubiksMachine._handover`): a deep
     #: giver's fingers reach across the faces the taker's fingers close on. None: the giver gives as it holds.
     giver_depth: int | None = None
+    #: the hand-over turn also carries the cube back to ``twist_position`` (the believed centre's offset from
+    #: it spread evenly over the turn's waypoints): each hand-over's belief and grip errors otherwise add up,
+    #: and the cube wandered 14 mm down and 7 mm out over 10 moves until a turn left the arms' reach
+    #: (HERB, PyBullet Rubiks-1-20). False (the PR2's recorded results): the turn is about the centre only.
+    recentre_turn: bool = False
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.
     handover_waypoints: int = 4
     #: the hand that is about to hold the cube alone (the picker, a hand-over's taker) grips two slabs deep

@@ -93,6 +93,11 @@ class Hand:
     log: list = field(default_factory=list)
 
 
+def _shifted(pose: Pose, shift: np.ndarray) -> Pose:
+    """``pose`` translated by ``shift`` (m, world)."""
+    return Pose(pose.p + shift, pose.q)
+
+
 @dataclass(frozen=True)
 class GripRequest:
     """What the machine asks of a grasp module's grip.
@@ -113,6 +118,9 @@ class GripRequest:
     on_table: bool = False  #: the cube is on the table: no finger may go under it
     relation: str | None = None
     take: bool = False  #: a hand-over's take (the other hand is the giver)
+    twist_now: bool = (
+        False  #: the hand twists right after this grip (the rotator's re-grip before a twist)
+    )
 
 
 class GraspModule(Protocol):
@@ -499,6 +507,12 @@ class BimanualRubiksMachine:
         )
         return np.asarray(res.q[0], dtype=float) if ok else None
 
+    def _turn_shift(self) -> np.ndarray:
+        """How far a hand-over turn carries the believed cube centre besides turning it (``recentre_turn``)."""
+        if not self.config.recentre_turn:
+            return np.zeros(3)
+        return np.asarray(self.config.twist_position, dtype=float) - self.est.p
+
     def turn_travel(
         self,
         hand: Hand,
@@ -543,7 +557,11 @@ class BimanualRubiksMachine:
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
-            poses = [rotate_about_point(grips[k], self.est.p, axis, angle * i / n) for k in live]
+            shift = self._turn_shift() * (i / n)
+            poses = [
+                _shifted(rotate_about_point(grips[k], self.est.p, axis, angle * i / n), shift)
+                for k in live
+            ]
             if back > 0:  # the retreat
                 poses = [self.back_off(p, back) for p in poses]
             targets = [(base.inv() * p).as_matrix() for p in poses]
@@ -1058,6 +1076,7 @@ class BimanualRubiksMachine:
         take: bool = False,
         twist_delta: float | None = None,
         give_turn: tuple[str, float] | None = None,
+        twist_now: bool = False,
     ) -> None:
         """``hand`` grips the cube from ``world_dir``, ``depth`` slabs deep: choose, swing to the stand-off,
         move in and close (the last by the grasp module), then the bookkeeping.
@@ -1075,7 +1094,9 @@ class BimanualRubiksMachine:
             turn = give_turn
         if twist_delta is None:
             twist_delta = self._next_twist_delta(k, hand.side) if depth == 1 else 0.0
-        req = GripRequest(world_dir, depth, label, turn, twist_delta, on_table, relation, take)
+        req = GripRequest(
+            world_dir, depth, label, turn, twist_delta, on_table, relation, take, twist_now
+        )
         grasp = self.grasp
         pose, q_plan = grasp.choose(self, hand, req)
         grasp.ready(self, hand, req)
@@ -1173,7 +1194,7 @@ class BimanualRubiksMachine:
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             # after a twist the rotator stands off: a twist right after a twist re-takes its slab
             if hold.holding and hold.depth == 2 and not rot.holding:
-                self.grip(rot, SIDE_DIR[rot.side], 1, "re-grip", twist_delta=delta)
+                self.grip(rot, SIDE_DIR[rot.side], 1, "re-grip", twist_delta=delta, twist_now=True)
         if not (rot.holding and hold.holding and rot.depth == 1 and hold.depth == 2):
             raise StrategyFailure(None, f"twist {k + 1}: hands not in twisting grips")
         move = twist_move(orientation, t.axis, t.layer, t.quarter_turns)
@@ -1271,12 +1292,13 @@ class BimanualRubiksMachine:
             )
         self.release_hand(taker, retreat=cfg.taker_retreat)
         centre = self.est.p.copy()
+        shift = self._turn_shift()
         n = max(1, cfg.handover_waypoints) * abs(a.quarter_turns)
         start = giver.cmd
         for i in range(1, n + 1):
             self.send(
                 giver,
-                rotate_about_point(start, centre, a.axis, angle * i / n),
+                _shifted(rotate_about_point(start, centre, a.axis, angle * i / n), shift * (i / n)),
                 label="hand-over turn",
                 settle=0.05 if i < n else 0.2,
             )

@@ -41,12 +41,14 @@ class HerbPushGraspConfig(BimanualConfig):
     #: published zero). 60 deg keeps their bent distal links 73 mm off the palm axis (clear of a 57 mm
     #: cube's sides during the push) without spreading the hand 17 cm wide (docs/herb_push_grasp.md).
     outer_open_flex: float = math.radians(60.0)
-    #: thumb (F3, the "middle finger") flex of the rotator's pre-shape (rad). From FK of the corrected
-    #: hand (docs/herb_push_grasp.md): the distal link's farthest corner stands 33.2 mm beyond the tool
-    #: frame, 14.7 mm past the palm axis; the closing outer fingers meet the cube's sides 3-7 mm deep
-    #: (measured), on the outer slab, their distal boxes reaching ~19 mm deep. Deeper (104 deg, 29.4 mm)
-    #: the rotator's fingertips struck the holder's during the twist (51 N, the layer turned 62-73 deg).
-    rotator_thumb_flex: float = math.radians(100.0)
+    #: thumb (F3, the "middle finger") flex of the rotator's pre-shape (rad). From FK of the corrected hand
+    #: (docs/herb_push_grasp.md): the distal link's farthest corner stands ~35 mm beyond the tool frame, so
+    #: the closing outer fingers meet the cube's sides ~2 mm deep (centred pinch), on the outer slab. The
+    #: outer fingers' bent distal boxes lie along the side faces 13-17 mm past their contact: at 100 deg
+    #: (contact 3-7 mm) they reached the middle slab's sides (19 mm), which the rolling fingertip then
+    #: pushed round (18-37 N on the middle slab, PyBullet Rubiks-1-20: F' dragged the held slab 54 deg).
+    #: Deeper still (104 deg) the rotator's fingertips struck the holder's (51 N, the layer turned 62-73 deg).
+    rotator_thumb_flex: float = math.radians(98.0)
     #: thumb flex of the holder's pre-shape (rad): tip 18.9 mm beyond the tool frame; its fingers meet
     #: the sides 15-23 mm deep on SAPIEN (F1/F2 differ: the held cube sits off the pinch centre and the
     #: tips close on an arc), 17 mm on PyBullet, and their distal boxes end ~35 mm deep, 2 mm short of
@@ -55,6 +57,11 @@ class HerbPushGraspConfig(BimanualConfig):
     #: found no grip that clears the giver's fingers (Rubiks-1-5 `unreachable` on both engines); at
     #: 125-128 deg (pinch 20-28 mm) the fingertips reached 40 mm and met the rotator's in the twist.
     holder_thumb_flex: float = math.radians(121.0)
+    #: thumb flex of a giver's one-slab grip for a hand-over turn (rad; None: the rotator's): the giver does
+    #: not twist, so its fingertips may reach the middle slab; the rotator's 98 deg left a giver 0-3 mm deep
+    #: and the cube fell in the turn (PyBullet Rubiks-1-20). 100 deg (contact 3-7 mm) is the deepest whose
+    #: fingers clear a two-slab taker's (``handover_clearance``): at 101 and 103 deg a give grip found none.
+    giver_thumb_flex: float | None = math.radians(100.0)
     #: the tool frame stands this far off the face's centre towards the thumb's root (m, tool +y). The
     #: corrected thumb's tip lands within 3.4 mm of the palm axis at both flexes: no offset needed.
     rotator_thumb_offset: float = 0.0
@@ -127,6 +134,10 @@ class HerbPushGraspConfig(BimanualConfig):
     #: trial (Rubiks-5-5, PyBullet); the injected calibration and tracking errors are as large. The same 5 mm
     #: as ``reach_warning``.
     ik_slack: float | None = 0.005
+    #: the hand-over turn carries the cube back to ``twist_position`` (the machine's ``recentre_turn``): over
+    #: Rubiks-1-20's first 10 moves the cube wandered from (0.900, 0, 1.100) to (0.907, 0, 1.086) m and the
+    #: 11th hand-over turn's IK ended 6.9 mm off (PyBullet, seed 0).
+    recentre_turn: bool = True
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
     #: the picker and a hand-over's taker grip two slabs deep whichever hand rotates next (the machine's rule,
@@ -135,6 +146,14 @@ class HerbPushGraspConfig(BimanualConfig):
     #: hand let go). Measured with it (seed 0): Rubiks-1-5 succeeds on both engines, Rubiks-5-5 PyBullet 3/5
     #: (was 1/5), SAPIEN 4/5 (as before); it costs a push-grasp and a release per pick and take.
     lone_holder_two_slabs: bool = True
+    #: a hand that closed on the cube held by the other hand centres its pinch across the pinch axis when the
+    #: middle of its fingers' inner sides (FK of its joints) is farther than this off the tool frame (m;
+    #: None: never): it opens, moves across and closes again. Off: at 1.5 mm PyBullet's Rubiks-5-5 fell to
+    #: 1/5 (4/5 without): the FK offset after a re-centring was often no smaller (a held cube moves with the
+    #: re-closing fingers; overshoots of 1.6 -> 1.8 mm, 3.2 -> 4.2 mm), and each re-close shook the cube.
+    centre_tolerance: float | None = None
+    #: the fingers' inner sides must be this close to the cube's width apart (m) to be read as its side faces.
+    centre_width_tolerance: float = 0.006
     #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).
     max_waypoint_jump: float = 2.5
     #: a motion that ends farther than this from its target is logged as a warning event (m).

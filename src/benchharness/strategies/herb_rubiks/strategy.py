@@ -60,6 +60,9 @@ from .push import (
 
 __all__ = ["BarrettState", "PushGrasp", "PushGraspStrategy", "StrategyFailure"]
 
+#: :attr:`BarrettState.shape` of a giver's one-slab pre-shape (``giver_thumb_flex``)
+GIVE_SHAPE = 3
+
 
 def _axis_name(v) -> str:
     """The world axis nearest ``v`` ('+x', '-z', ...), for diagnostics."""
@@ -71,7 +74,7 @@ def _axis_name(v) -> str:
 class BarrettState:
     """What the push-grasp module keeps per hand (:attr:`..bimanual.machine.Hand.state`)."""
 
-    shape: int = 0  #: depth of the current pre-shape (0: none yet)
+    shape: int = 0  #: current pre-shape: 1 rotator, 2 holder, GIVE_SHAPE giver (0: none)
     face_depth: float = (
         0.0  #: thumb tip beyond the tool frame in the current pre-shape (m), measured
     )
@@ -109,10 +112,22 @@ class PushGrasp:
         return "parallel" if self.config.taker_parallel else "cross"
 
     # ------------------------------------------------------------- pre-shape and choice
+    def _shape(self, req: GripRequest) -> int:
+        """The pre-shape a grip takes: the holder's for two slabs, else the rotator's, or a giver's one-slab
+        grip for a hand-over turn (``giver_thumb_flex``)."""
+        if req.depth == 1 and req.turn is not None and self.config.giver_thumb_flex is not None:
+            return GIVE_SHAPE
+        return req.depth
+
     def _preshape(self, m: BimanualRubiksMachine, hand: Hand, depth: int) -> None:
-        """Spread 90 deg, outer fingers open, thumb flexed for ``depth``; measure how far the thumb reaches."""
+        """Spread 90 deg, outer fingers open, thumb flexed for pre-shape ``depth`` (1, 2 or GIVE_SHAPE);
+        measure how far the thumb reaches."""
         cfg = self.config
-        flex = cfg.rotator_thumb_flex if depth == 1 else cfg.holder_thumb_flex
+        if depth == GIVE_SHAPE:
+            assert cfg.giver_thumb_flex is not None
+            flex = cfg.giver_thumb_flex
+        else:
+            flex = cfg.rotator_thumb_flex if depth == 1 else cfg.holder_thumb_flex
         preshape(
             hand.gripper,
             cfg.spread,
@@ -141,12 +156,13 @@ class PushGrasp:
         carry that turn and the retreat after it without an IK flip
         (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`); if no grip does, one whose
         turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not).
-        Returns no IK solution: the arm moves to the stand-off from where it is.
+        Returns the IK solution to reach the grip by when the wrist had to be re-seeded for the twist
+        (see below), else None: the arm moves to the stand-off from where it is.
         """
         cfg = self.config
         st = _st(hand)
-        if st.shape != req.depth:
-            self._preshape(m, hand, req.depth)
+        if st.shape != self._shape(req):
+            self._preshape(m, hand, self._shape(req))
         world_dir, turn, twist_delta = req.world_dir, req.turn, req.twist_delta
         perpendicular, parallel = req.relation == "cross", req.relation == "parallel"
         other = m.other(hand)
@@ -158,96 +174,123 @@ class PushGrasp:
         base = hand.arm.base_pose()
         q_now = hand.arm.positions()
         lo, hi = hand.arm.lower[-1], hand.arm.upper[-1]
-        best: Pose | None = None
-        second: Pose | None = (
-            None  # a giver's grip whose turn is smooth but not the retreat after it
-        )
-        fallback: Pose | None = None
-        best_score = second_score = fallback_score = -np.inf
-        best_slide = second_slide = fallback_slide = 0.0
-        # diagnostic for the recorder: each candidate and why it was taken or not
-        tried: list[str] = []
-        lateral = cfg.rotator_thumb_offset if st.shape == 1 else cfg.holder_thumb_offset
-        for pose in push_grip_candidates(m.est, world_dir, st.face_depth):
-            fx = pinch_axis(pose)
-            tag = f"pinch {_axis_name(fx)} thumb {_axis_name(pose.rotation.apply([0.0, 1.0, 0.0]))}"
-            shift: float | None = lateral
-            if other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7:
-                # both hands on the same faces
-                shift = self._clear_lateral(m, hand, pose, lateral)
-                if shift is None:
-                    tried.append(f"{tag}: fingers cannot clear the other hand's")
-                    continue
-                if abs(shift - lateral) > 1e-4:
-                    tag += f" slid {1000 * (shift - lateral):+.0f} mm"
-            assert shift is not None
-            pose = Pose(pose.p + pose.rotation.apply([0.0, shift, 0.0]), pose.q)
-            if req.on_table and (
-                abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7
-            ):
-                # on the table: no outer finger under the cube, and the thumb's root below (its tip
-                # curls up onto the face, clear of the table top)
-                continue
-            crossing = other_x is None or abs(float(np.dot(fx, other_x))) < 0.3
-            if other_on_axis and other_z is not None:
-                crossing = crossing and abs(float(np.dot(fx, other_z))) < 0.3
-            if perpendicular and not crossing:
-                tried.append(f"{tag}: not crossing")
-                continue
-            if parallel and (other_x is None or abs(float(np.dot(fx, other_x))) < 0.7):
-                tried.append(f"{tag}: not parallel")
-                continue
-            res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q_now)
-            if not res.success[0]:
-                tried.append(f"{tag}: no IK")
-                continue
-            q7 = float(res.q[0][-1])
-            margin = min(q7 - lo, hi - q7, q7 + twist_delta - lo, hi - (q7 + twist_delta))
-            joint_move = float(np.max(np.abs(res.q[0] - q_now)))
-            score = min(margin, 0.3) - 0.1 * joint_move + (0.5 if crossing else 0.0)
-            if margin < 0.0:
-                score -= 10.0
-            if turn is not None:
-                # the giver's pinch must not end on the work axis after the turn: its fingertip would sit
-                # on the face the taker's thumb comes to, and the taker's push would meet the finger
-                turned = Rotation.from_rotvec(DIRECTIONS[turn[0]] * turn[1])
-                if abs(float(turned.apply(fx)[1])) > 0.7:
-                    tried.append(f"{tag}: pinch on the work axis after the turn")
-                    continue
-                # and its thumb, curled over the face it pushed, should rise towards its root on the side
-                # away from the taker (a preference: with the root on the taker's side, the giver's fingers,
-                # 12 mm off centre towards the root, are where the taker's fingertips close)
-                taker_dir = DIRECTIONS[SIDE_DIR[other.side]]
-                if (
-                    float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir))
-                    > -0.7
-                ):
-                    score -= 1.0
-                if score > fallback_score:
-                    fallback, fallback_score, fallback_slide = pose, score, shift - lateral
-                travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
-                if not np.isfinite(travel[0]):
-                    # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
-                    # turn alone is smooth is the second choice (the retreat is then cut short)
-                    short, _ = m.turn_travel(
-                        hand, base, [pose], res.q[:1], *turn, with_retreat=False
-                    )
-                    tried.append(
-                        f"{tag}: turn + retreat not smooth (score {score:.2f}; largest joint step "
-                        f"{float(worst[0]):.2f} rad; turn alone "
-                        f"{'smooth' if np.isfinite(short[0]) else 'not smooth'})"
-                    )
-                    if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
-                        second = pose
-                        second_score = score - 0.1 * float(short[0])
-                        second_slide = shift - lateral
-                    continue
-                score -= 0.1 * float(travel[0])
-            tried.append(
-                f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})"
+        # a second pass, the wrist re-seeded, only when every grip of a rotator about to twist leaves
+        # the wrist short of the twist (earlier grips leave it to ``regrip_before_twist``: re-seeded
+        # there, arms took other branches and a later twist dragged, SAPIEN Rubiks-5-5 trial 4)
+        for reseed in (False, True):
+            best: Pose | None = None
+            second: Pose | None = (
+                None  # a giver's grip whose turn is smooth but not the retreat after it
             )
-            if score > best_score:
-                best, best_score, best_slide = pose, score, shift - lateral
+            fallback: Pose | None = None
+            best_score = second_score = fallback_score = -np.inf
+            best_slide = second_slide = fallback_slide = 0.0
+            best_q: np.ndarray | None = None  # the IK solution to reach ``best`` by, if re-seeded
+            # diagnostic for the recorder: each candidate and why it was taken or not
+            tried: list[str] = []
+            lateral = cfg.holder_thumb_offset if st.shape == 2 else cfg.rotator_thumb_offset
+            for pose in push_grip_candidates(m.est, world_dir, st.face_depth):
+                fx = pinch_axis(pose)
+                tag = f"pinch {_axis_name(fx)} thumb {_axis_name(pose.rotation.apply([0.0, 1.0, 0.0]))}"
+                shift: float | None = lateral
+                if other_x is not None and abs(float(np.dot(fx, other_x))) >= 0.7:
+                    # both hands on the same faces
+                    shift = self._clear_lateral(m, hand, pose, lateral)
+                    if shift is None:
+                        tried.append(f"{tag}: fingers cannot clear the other hand's")
+                        continue
+                    if abs(shift - lateral) > 1e-4:
+                        tag += f" slid {1000 * (shift - lateral):+.0f} mm"
+                assert shift is not None
+                pose = Pose(pose.p + pose.rotation.apply([0.0, shift, 0.0]), pose.q)
+                if req.on_table and (
+                    abs(fx[2]) > 0.7 or pose.rotation.apply([0.0, 1.0, 0.0])[2] > -0.7
+                ):
+                    # on the table: no outer finger under the cube, and the thumb's root below (its tip
+                    # curls up onto the face, clear of the table top)
+                    continue
+                crossing = other_x is None or abs(float(np.dot(fx, other_x))) < 0.3
+                if other_on_axis and other_z is not None:
+                    crossing = crossing and abs(float(np.dot(fx, other_z))) < 0.3
+                if perpendicular and not crossing:
+                    tried.append(f"{tag}: not crossing")
+                    continue
+                if parallel and (other_x is None or abs(float(np.dot(fx, other_x))) < 0.7):
+                    tried.append(f"{tag}: not parallel")
+                    continue
+                res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q_now)
+                if not res.success[0]:
+                    tried.append(f"{tag}: no IK")
+                    continue
+                q7 = float(res.q[0][-1])
+                margin = min(q7 - lo, hi - q7, q7 + twist_delta - lo, hi - (q7 + twist_delta))
+                q_seeded: np.ndarray | None = None
+                if reseed and margin < 0.0 and np.isfinite(lo) and np.isfinite(hi):
+                    # seeded from where the arm is, IK spreads the grip's roll over the forearm and wrist
+                    # joints and leaves the wrist no room for the twist (measured: all four grips of a
+                    # half turn's re-grip 1.0-3.1 rad short, the wrist limited 177 deg short and F2 jammed,
+                    # SAPIEN and PyBullet Rubiks-5-5 trial 4); seeded with the wrist in the middle of the
+                    # twist's room, the arm's redundancy takes the roll instead
+                    seed = np.array(q_now, dtype=float)
+                    seed[-1] = 0.5 * (max(lo, lo - twist_delta) + min(hi, hi - twist_delta))
+                    alt = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
+                    if alt.success[0]:
+                        a7 = float(alt.q[0][-1])
+                        alt_margin = min(
+                            a7 - lo, hi - a7, a7 + twist_delta - lo, hi - (a7 + twist_delta)
+                        )
+                        if alt_margin > margin:
+                            res, q7, margin = alt, a7, alt_margin
+                            q_seeded = np.asarray(alt.q[0], dtype=float)
+                            tag += " (wrist re-seeded)"
+                joint_move = float(np.max(np.abs(res.q[0] - q_now)))
+                score = min(margin, 0.3) - 0.1 * joint_move + (0.5 if crossing else 0.0)
+                if margin < 0.0:
+                    score -= 10.0
+                if turn is not None:
+                    # the giver's pinch must not end on the work axis after the turn: its fingertip would sit
+                    # on the face the taker's thumb comes to, and the taker's push would meet the finger
+                    turned = Rotation.from_rotvec(DIRECTIONS[turn[0]] * turn[1])
+                    if abs(float(turned.apply(fx)[1])) > 0.7:
+                        tried.append(f"{tag}: pinch on the work axis after the turn")
+                        continue
+                    # and its thumb, curled over the face it pushed, should rise towards its root on the side
+                    # away from the taker (a preference: with the root on the taker's side, the giver's fingers,
+                    # 12 mm off centre towards the root, are where the taker's fingertips close)
+                    taker_dir = DIRECTIONS[SIDE_DIR[other.side]]
+                    if (
+                        float(np.dot(turned.apply(pose.rotation.apply([0.0, 1.0, 0.0])), taker_dir))
+                        > -0.7
+                    ):
+                        score -= 1.0
+                    if score > fallback_score:
+                        fallback, fallback_score, fallback_slide = pose, score, shift - lateral
+                    travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
+                    if not np.isfinite(travel[0]):
+                        # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
+                        # turn alone is smooth is the second choice (the retreat is then cut short)
+                        short, _ = m.turn_travel(
+                            hand, base, [pose], res.q[:1], *turn, with_retreat=False
+                        )
+                        tried.append(
+                            f"{tag}: turn + retreat not smooth (score {score:.2f}; largest joint step "
+                            f"{float(worst[0]):.2f} rad; turn alone "
+                            f"{'smooth' if np.isfinite(short[0]) else 'not smooth'})"
+                        )
+                        if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
+                            second = pose
+                            second_score = score - 0.1 * float(short[0])
+                            second_slide = shift - lateral
+                        continue
+                    score -= 0.1 * float(travel[0])
+                tried.append(
+                    f"{tag}: score {score:.2f} (wrist margin {margin:.2f}, move {joint_move:.2f})"
+                )
+                if score > best_score:
+                    best, best_score, best_slide = pose, score, shift - lateral
+                    best_q = q_seeded
+            if reseed or not req.twist_now or best is None or best_score > -5.0:
+                break
         if best is None and second is not None:
             m.ctx.recorder.event(
                 "warning",
@@ -273,7 +316,7 @@ class PushGrasp:
                 "unreachable", f"{hand.side} arm: no push-grasp from {world_dir} reachable"
             )
         st.slide = best_slide
-        return best, None
+        return best, best_q
 
     def _clear_lateral(
         self, m: BimanualRubiksMachine, hand: Hand, face_pose: Pose, nominal: float
@@ -392,6 +435,85 @@ class PushGrasp:
             raise StrategyFailure(
                 None, f"{label}: {hand.side} outer fingers closed on nothing (grasp missed)"
             )
+        if cfg.centre_tolerance is not None and m.other(hand).holding:
+            self._centre_pinch(m, hand, label)
+
+    def _pinch_sides(
+        self, m: BimanualRubiksMachine, hand: Hand
+    ) -> tuple[float, float, float, float]:
+        """Where the closed outer fingers' distal boxes stand, from the hand's measured joints (FK).
+
+        Returns (inner side of the finger on tool -x, of the finger on tool +x, their depths beyond the
+        tool frame) (m, tool frame): each finger's inner side is on a side face of the cube.
+        """
+        prefix = hand.arm.config.tcp_link.split("_")[0]
+        tool = hand.arm.tcp_pose()
+        sides = []
+        for f in ("1", "2"):
+            link = m.b.get_link_pose(m.robot.body, f"{prefix}_bh_finger_{f}3_link")
+            loc = tool.rotation.inv().apply(link.rotation.apply(DIST_CORNERS) + link.p - tool.p)
+            neg = float(np.mean(loc[:, 0])) < 0.0
+            x = float(np.max(loc[:, 0])) if neg else float(np.min(loc[:, 0]))
+            # the corners on the inner side (within 2 mm of it) touch the face: their depth
+            near = np.abs(loc[:, 0] - x) < 0.002
+            sides.append((neg, x, float(np.min(loc[near, 2]))))
+        sides.sort(key=lambda t: not t[0])
+        (_, x_neg, z_neg), (_, x_pos, z_pos) = sides
+        return x_neg, x_pos, z_neg, z_pos
+
+    def _centre_pinch(self, m: BimanualRubiksMachine, hand: Hand, label: str) -> None:
+        """Centre the pinch on the cube across the pinch axis (tool x), from the closed fingers' joints.
+
+        The push re-anchors the belief along the approach only; across the pinch the belief keeps its
+        error, and the two outer fingers' tips, closing on arcs, meet the side faces at depths that
+        differ by ~1.3 mm per mm of that error (FK): the holder's pinch then lands on the outer slab on
+        one side, and a rotator's deeper fingertip reaches the middle slab, which it drags round
+        (measured, PyBullet Rubiks-1-20). The fingers' inner sides are the side faces: if their middle
+        is more than ``centre_tolerance`` off the tool frame, the hand opens, moves across by that much
+        (the belief is re-anchored across the pinch) and closes again.
+        """
+        cfg = self.config
+        assert cfg.centre_tolerance is not None
+        x_neg, x_pos, z_neg, z_pos = self._pinch_sides(m, hand)
+        off = 0.5 * (x_neg + x_pos)
+        width = x_pos - x_neg
+        event: dict[str, Any] = {
+            "hand": hand.side,
+            "label": label,
+            "offset_mm": 1000 * off,
+            "width_mm": 1000 * width,
+            "depths_mm": [
+                1000 * (z_neg - _st(hand).face_depth),
+                1000 * (z_pos - _st(hand).face_depth),
+            ],
+        }
+        if (
+            abs(off) <= cfg.centre_tolerance
+            or abs(width - 2 * CUBE_HALF) > cfg.centre_width_tolerance
+        ):
+            event["moved"] = False
+            m.ctx.recorder.event("centre", **event)
+            return
+        x = pinch_axis(hand.cmd)
+        self.open(m, hand)
+        m.send(hand, Pose(hand.cmd.p + off * x, hand.cmd.q), label=f"{label} centre", settle=0.1)
+        m.est = Pose(m.est.p + (float(np.dot(hand.cmd.p - m.est.p, x))) * x, m.est.q)
+        m.reanchor()
+        close_outer_fingers(hand.gripper, cfg.grip_torque, speed=cfg.finger_speed)
+        if not self._outer_touching(m, hand):
+            raise StrategyFailure(
+                None, f"{label}: {hand.side} outer fingers closed on nothing after centring"
+            )
+        x_neg, x_pos, z_neg, z_pos = self._pinch_sides(m, hand)
+        event.update(
+            moved=True,
+            offset_after_mm=500 * (x_neg + x_pos),
+            depths_after_mm=[
+                1000 * (z_neg - _st(hand).face_depth),
+                1000 * (z_pos - _st(hand).face_depth),
+            ],
+        )
+        m.ctx.recorder.event("centre", **event)
 
     def _outer_touching(self, m: BimanualRubiksMachine, hand: Hand) -> bool:
         links = {
@@ -453,15 +575,26 @@ class PushGrasp:
 
     def twist_diagnostics(self, m: BimanualRubiksMachine, body_axis: str) -> dict | None:
         """Which slabs each hand's links touch (engine contacts): a diagnostic for the recorder."""
-        out: dict[str, list[int]] = {}
+        out: dict[str, Any] = {}
+        true_inv = m.cube.pose().inv()
         for side, h in m.hands.items():
             prefix = h.arm.config.tcp_link.split("_")[0] + "_bh_"
-            slabs = {
-                m.cube.layer_of(c.position.tolist(), body_axis)
+            contacts = [
+                c
                 for c in m.b.contacts(m.robot.body, m.cube.body)
                 if c.link_a and c.link_a.startswith(prefix) and c.normal_force > 0.1
-            }
-            out[side] = sorted(slabs)
+            ]
+            out[side] = sorted({m.cube.layer_of(c.position.tolist(), body_axis) for c in contacts})
+            # how deep each outer finger touches the cube, from this hand's face (true poses: recorder only)
+            z = true_inv.rotation.apply(approach_axis(h.arm.tcp_pose()))
+            depths: dict[str, list[float]] = {}
+            for c in contacts:
+                link = (c.link_a or "")[len(prefix) :].removesuffix("_link")
+                if link.startswith("finger_3"):
+                    continue
+                d = 1000 * (CUBE_HALF + float(np.dot(true_inv.apply(c.position), z)))
+                depths.setdefault(link, []).append(round(d, 1))
+            out[f"{side}_depth_mm"] = {k: [min(v), max(v)] for k, v in sorted(depths.items())}
         return out
 
 
