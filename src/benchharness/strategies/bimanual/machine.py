@@ -560,6 +560,66 @@ class BimanualRubiksMachine:
             q[live] = res.q
         return total, worst
 
+    def turn_postures(
+        self, hand: Hand, base: Pose, grips: list[Pose], axis: str, angle: float, n_seeds: int
+    ) -> tuple[list[int], np.ndarray]:
+        """Arm postures from which each of ``grips`` carries the hand-over turn, found backwards.
+
+        For every grip, ``n_seeds`` starts drawn uniformly over the arm's joint range (a continuous
+        joint over one turn about where it is) from ``plan_rng`` are solved for the end of the giver's retreat
+        (``handover_retreat`` back from the turned grip); from each solution the chain is solved
+        backwards, each pose seeded with the last solution: the retreat's 2 cm steps (each joint
+        path checked clear of the cube with the grasp module's ``hand_points``, as made forwards),
+        then the turn's waypoints back to the grip. A chain with every step smooth
+        (``max_waypoint_jump``) gives the grip's IK solution at its start. Returns (index into
+        ``grips``, solution) of every chain that passed.
+
+        Why: :meth:`turn_travel` solves the turn forwards from postures near the arm's joints, so
+        it only finds the branch the arm is near. Measured (SAPIEN Rubiks-1-20 sensor-aided seed 0,
+        the right hand's take before a -90 deg turn about x): all 14 grips (2 placements x 7 seeds
+        near the joints, upper-arm roll at -3.3 rad) ended the turn with the upper-arm roll on its
+        soft limit (-3.75 rad) and the retreat's 6 cm step switched the forearm roll 1.7 rad; the
+        giver slid out 2 cm, its re-grip found no clear way round and turned the cube 41 deg.
+        Solved backwards from starts over the whole range, 299 of 300 chains passed, their grips
+        near an upper-arm roll of -1.1 rad.
+        """
+        cfg = self.config
+        n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
+        points = self._hand_points()
+        m = max(1, math.ceil(cfg.handover_retreat / 0.02 - 1e-9))
+        # a continuous joint over the turn centred on where it is (IK keeps it on the seed's branch:
+        # drawn over [-pi, pi], a wrist roll wound to 12 rad by the twists was unwound 9.7 rad)
+        q_now = hand.arm.positions()
+        lo = np.where(np.isfinite(hand.arm.lower), hand.arm.lower, q_now - math.pi)
+        hi = np.where(np.isfinite(hand.arm.upper), hand.arm.upper, q_now + math.pi)
+        owner = np.repeat(np.arange(len(grips)), n_seeds)
+        q = lo + self.plan_rng.random((len(owner), lo.size)) * (hi - lo)
+        live = np.ones(len(owner), dtype=bool)
+        # (waypoint of the turn, retreat distance) of each pose, from the retreat's end back to the grip
+        steps = [(n, cfg.handover_retreat * j / m) for j in range(m, 0, -1)]
+        steps += [(i, 0.0) for i in range(n, -1, -1)]
+        for s, (i, back) in enumerate(steps):
+            rows = np.flatnonzero(live)
+            if rows.size == 0:
+                break
+            poses = [rotate_about_point(grips[owner[r]], self.est.p, axis, angle * i / n) for r in rows]
+            if back > 0:
+                poses = [self.back_off(p, back) for p in poses]
+            res = hand.arm.ik(
+                np.stack([(base.inv() * p).as_matrix() for p in poses]), seed_q=q[rows]
+            )
+            bad = ~np.asarray(res.success, dtype=bool)
+            if s > 0:
+                bad |= np.max(np.abs(res.q - q[rows]), axis=1) > cfg.max_waypoint_jump
+                if points is not None and steps[s - 1][1] > 0:  # a retreat step, made forwards
+                    for j, r in enumerate(rows):
+                        if not bad[j]:
+                            bad[j] = not self._clears(hand, res.q[j], q[r], points)
+            q[rows] = res.q
+            live[rows[bad]] = False
+        keep = np.flatnonzero(live)
+        return [int(owner[r]) for r in keep], q[keep]
+
     def _swing(self, hand: Hand, far: Pose, label: str, seed_q: np.ndarray | None = None) -> None:
         """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed centre.
 

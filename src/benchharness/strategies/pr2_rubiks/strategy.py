@@ -39,6 +39,11 @@ __all__ = [
 ]
 
 
+#: radius (m) of the wrist flex link's collision sphere, centred on the wrist roll axis at the palm
+#: link's origin (robots/descriptions/pr2.py): rigid with the tool frame whatever the wrist roll
+WRIST_RADIUS = 0.035
+
+
 def _open_hand_points() -> np.ndarray:
     from ...robots.descriptions.pr2 import GRIPPER_MAX_OPENING, PALM_BOX, TCP_X, finger_boxes
 
@@ -46,7 +51,13 @@ def _open_hand_points() -> np.ndarray:
     g = np.linspace(-0.5, 0.5, 5)
     grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
     pts = np.concatenate([np.asarray(c) + grid * np.asarray(s) for c, s in boxes])
-    return pts - np.array([TCP_X, 0.0, 0.0])
+    # the wrist flex link's sphere (the palm frame's origin): a stand-off move that changes the arm's
+    # posture can swing the wrist through the cube with the hand itself well clear (measured: 52 N from
+    # l_wrist_flex_link, the tool frame never nearer than 125 mm, the held cube turned 90 deg; SAPIEN
+    # Rubiks-1-20 sensor-aided seed 0)
+    ball = grid * 2 * WRIST_RADIUS
+    ball = ball[np.linalg.norm(ball, axis=1) <= WRIST_RADIUS + 1e-9]
+    return np.concatenate([pts, ball]) - np.array([TCP_X, 0.0, 0.0])
 
 
 class PR2Grasp:
@@ -68,7 +79,8 @@ class PR2Grasp:
 
     def hand_points(self) -> np.ndarray:
         """Points (tool frame, m) filling the open hand's collision boxes: both pads and finger bars at
-        the 90 mm opening and the palm (:func:`...robots.descriptions.pr2.finger_boxes`); the machine keeps
+        the 90 mm opening, the palm (:func:`...robots.descriptions.pr2.finger_boxes`) and the wrist flex
+        link's sphere behind it (rigid with the tool frame: on the wrist roll axis); the machine keeps
         them clear of the cube when the free hand moves to a stand-off (``sweep_clearance``)."""
         return _open_hand_points()
 
@@ -141,6 +153,7 @@ class PR2Grasp:
                 "unreachable",
                 f"{hand.side} arm: no finger placement from {world_dir} clears the other hand",
             )
+        placements, place_bonus = list(poses), list(bonus)
         seeds = [q_now]
         if turn is not None and cfg.giver_seeds > 0:
             # a giver also tries other arm configurations (the 7-DOF arm's self-motion) for each
@@ -174,7 +187,11 @@ class PR2Grasp:
             turned[np.flatnonzero(ok)] -= 0.1 * travel
             if np.isfinite(turned).any():
                 score = turned
-            else:  # the least bad: the smallest largest jump on the way
+            else:
+                found = self._backward_grip(m, hand, base, placements, place_bonus, q_now, turn)
+                if found is not None:
+                    return found
+                # the least bad: the smallest largest jump on the way
                 score[np.flatnonzero(ok)] -= worst
                 m.ctx.recorder.event(
                     "warning",
@@ -183,6 +200,48 @@ class PR2Grasp:
                 )
         best = int(np.argmax(score))
         return poses[best], np.array(res.q[best], dtype=float)
+
+    def _backward_grip(
+        self,
+        m: BimanualRubiksMachine,
+        hand: Hand,
+        base: Pose,
+        placements: list[Pose],
+        bonus: list[float],
+        q_now: np.ndarray,
+        turn: tuple[str, float],
+    ) -> tuple[Pose, np.ndarray] | None:
+        """A giver's grip whose turn and retreat run smoothly, from postures found backwards from the
+        retreat's end (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`, ``giver_backward_seeds``
+        starts per placement), when none near the arm's joints does; checked forwards again
+        (``turn_travel``) and scored as :meth:`choose` scores (joint change, finger bonus, turn travel).
+        None: none found. Recorded as a ``giver_posture`` event."""
+        n = self.config.giver_backward_seeds
+        if n <= 0:
+            return None
+        owner, qs = m.turn_postures(hand, base, placements, *turn, n_seeds=n)
+        if not owner:
+            return None
+        grips = [placements[i] for i in owner]
+        travel, _ = m.turn_travel(hand, base, grips, qs, *turn)
+        score = np.array(
+            [
+                -0.1 * float(np.max(np.abs(qs[j] - q_now))) + bonus[owner[j]] - 0.1 * travel[j]
+                for j in range(len(owner))
+            ]
+        )
+        if not np.isfinite(score).any():
+            return None
+        best = int(np.argmax(score))
+        m.ctx.recorder.event(
+            "giver_posture",
+            hand=hand.side,
+            chains=len(owner),
+            checked=int(np.isfinite(travel).sum()),
+            joint_change=round(float(np.max(np.abs(qs[best] - q_now))), 2),
+            travel=round(float(travel[best]), 2),
+        )
+        return grips[best], np.array(qs[best], dtype=float)
 
     def ready(self, m: BimanualRubiksMachine, hand: Hand, req: GripRequest) -> None:
         hand.gripper.open(wait=0.3)
