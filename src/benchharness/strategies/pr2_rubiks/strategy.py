@@ -233,6 +233,8 @@ class PR2Grasp:
         if not np.isfinite(score).any():
             return None
         best = int(np.argmax(score))
+        # another branch: the stand-off move changes posture away from the cube
+        hand.far_posture = True
         m.ctx.recorder.event(
             "giver_posture",
             hand=hand.side,
