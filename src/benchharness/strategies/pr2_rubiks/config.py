@@ -92,6 +92,10 @@ class PR2RubiksConfig(BimanualConfig):
     #: The seeds near the arm's joints find only the branch it is on (measured: every one of 14 ended a
     #: turn with the upper-arm roll on its soft limit, SAPIEN Rubiks-1-20). 0: the least bad grip instead.
     giver_backward_seeds: int = 8
+    #: a grip posture whose upper arm or forearm comes nearer the other (holding) arm than this (m), both
+    #: modelled as 5 cm round their axes, is not chosen while another is (the arms collide in the engines:
+    #: measured, a hand-over take stopped 25 mm short against the giver's elbow, PyBullet Rubiks-1-20).
+    arm_clearance: float = 0.01
     #: pre-touch (sensor-aided): std of the prior handed to the filter at each re-localisation, position
     #: (m) and yaw (deg): of the order of the head camera's error (4 mm, 3 deg) that dead reckoning carries.
     pretouch_prior_pos_std: float = 0.006

@@ -44,6 +44,41 @@ __all__ = [
 WRIST_RADIUS = 0.035
 
 
+#: radius (m) round the segments shoulder lift -> elbow -> wrist flex within which the PR2's arm lies
+#: (the elbow flex link's sphere is 5 cm; the upper-arm and forearm boxes are 9 and 8 cm square)
+ARM_RADIUS = 0.05
+
+
+def _arm_points(hand: Hand, q: np.ndarray) -> np.ndarray | None:
+    """Points (world, m) on the arm's axis from the shoulder lift through the elbow to the wrist flex at
+    joints ``q`` (one row per configuration: (B, 13, 3)); None if the arm has no joint-origin model."""
+    o = hand.arm.joint_origins(np.atleast_2d(q))
+    if o is None:
+        return None
+    s = np.linspace(0.0, 1.0, 7)[:, None]
+    pts = np.concatenate(
+        [
+            o[:, None, 1] + s[None] * (o[:, None, 3] - o[:, None, 1]),
+            o[:, None, 3] + s[None, 1:] * (o[:, None, 5] - o[:, None, 3]),
+        ],
+        axis=1,
+    )
+    w = hand.arm.base_pose().as_matrix()
+    return np.einsum("ij,bpj->bpi", w[:3, :3], pts) + w[:3, 3]
+
+
+def arm_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
+    """Least distance (m) between ``hand``'s arm at each row of ``q`` and the other arm where it is, both
+    as ``ARM_RADIUS`` round their axes (inf: no joint-origin model)."""
+    mine = _arm_points(hand, q)
+    other = m.other(hand)
+    theirs = _arm_points(other, other.arm.positions())
+    if mine is None or theirs is None:
+        return np.full(len(np.atleast_2d(q)), np.inf)
+    d = np.linalg.norm(mine[:, :, None, :] - theirs[0][None, None, :, :], axis=-1)
+    return d.min(axis=(1, 2)) - 2 * ARM_RADIUS
+
+
 def _open_hand_points() -> np.ndarray:
     from ...robots.descriptions.pr2 import GRIPPER_MAX_OPENING, PALM_BOX, TCP_X, finger_boxes
 
@@ -178,6 +213,17 @@ class PR2Grasp:
             [-0.1 * float(np.max(np.abs(res.q[i] - q_now))) + bonus[i] for i in range(len(poses))]
         )
         score[~ok] = -np.inf
+        if other.holding:
+            # the other arm holds still meanwhile: a grip posture whose elbow or forearm meets it stops
+            # short of the grip (measured: a take 25 mm short, its pads on the cube's edges, against
+            # the giver's elbow at 63 N; the cube fell when the giver let go. PyBullet Rubiks-1-20)
+            clash = ok & (arm_clearance(m, hand, res.q) < cfg.arm_clearance)
+            if clash.any() and (ok & ~clash).any():
+                m.ctx.recorder.event(
+                    "arm_clash", hand=hand.side, label=req.label, rejected=int(clash.sum())
+                )
+                ok = ok & ~clash
+                score[clash] = -np.inf
         if turn is not None:
             travel, worst = m.turn_travel(
                 hand, base, [poses[i] for i in np.flatnonzero(ok)], res.q[ok], *turn
@@ -220,6 +266,9 @@ class PR2Grasp:
         if n <= 0:
             return None
         owner, qs = m.turn_postures(hand, base, placements, *turn, n_seeds=n)
+        if owner and m.other(hand).holding:
+            keep = np.flatnonzero(arm_clearance(m, hand, qs) >= self.config.arm_clearance)
+            owner, qs = [owner[j] for j in keep], qs[keep]
         if not owner:
             return None
         grips = [placements[i] for i in owner]
