@@ -59,6 +59,25 @@ def test_fk_matches_yourdfpy(robots, urdfs, robot, chain):
 
 
 @pytest.mark.parametrize("robot,chain", CHAINS)
+def test_joint_origins_match_yourdfpy(robots, urdfs, robot, chain):
+    """``RobotArm.joint_origins`` (the PR2 planner's arm-against-arm check) is each movable joint's child
+    link origin, as yourdfpy places it."""
+    arm = robots[robot].arm(chain)
+    u = urdfs[robot]
+    q = arm.chain.sample(10, torch.Generator().manual_seed(3))
+    ours = arm.joint_origins(q)
+    assert ours is not None and ours.shape == (len(q), len(arm.joints), 3)
+    children = [u.joint_map[j].child for j in arm.chain.joint_names]
+    for k in range(len(q)):
+        cfg = dict(zip(u.actuated_joint_names, np.zeros(len(u.actuated_joint_names))))
+        cfg.update(zip(arm.joints, q[k]))
+        u.update_cfg(cfg)
+        for i, child in enumerate(children):
+            ref = u.get_transform(child, arm.config.base_link)[:3, 3]
+            np.testing.assert_allclose(ours[k, i], ref, atol=1e-6)
+
+
+@pytest.mark.parametrize("robot,chain", CHAINS)
 def test_jacobian_matches_finite_differences(robots, robot, chain):
     arm = robots[robot].arm(chain)
     q = arm.chain.sample(3, torch.Generator().manual_seed(3), margin=0.05)

@@ -354,6 +354,24 @@ class _SerialModel:
         jac[:, 3:, self._joint_idx] = jw.transpose(0, 2, 1)
         return tip, jac
 
+    def joint_origins(self, q: np.ndarray) -> np.ndarray:
+        """Origins of the movable joints' frames in the root frame, (B, K, 3), in chain order."""
+        x = q if self._identity_order else q[:, self._joint_idx]
+        s = np.sin(x)[:, :, None, None]
+        c = 1.0 - np.cos(x)[:, :, None, None]
+        jt = np.zeros((q.shape[0], len(self.joint), 4, 4))
+        jt[:, :, :3, :3] = self._eye3 + s * self._skew + c * self._skew2
+        jt[:, :, :3, 3] = (x * self._pris)[:, :, None] * self._axes
+        jt[:, :, 3, 3] = 1.0
+        local = self._pre @ jt
+        out = np.empty((q.shape[0], len(self.joint), 3))
+        t = local[:, 0]
+        out[:, 0] = t[:, :3, 3]
+        for k in range(1, local.shape[1]):
+            t = t @ local[:, k]
+            out[:, k] = t[:, :3, 3]
+        return out
+
 
 class KinematicChain:
     """A serial chain ``root_link`` -> ``tip_link`` of a URDF (e.g. one arm, one finger)."""
@@ -432,6 +450,12 @@ class KinematicChain:
         if qa.shape[0] <= _NUMPY_FK_MAX_BATCH:
             return self._np.fk_jacobian(qa)[0]
         return self._fk_pk(qa)
+
+    def joint_origins(self, q) -> np.ndarray | None:
+        """Origins of the movable joints (B, K, 3) in the root frame (None: the chain has no NumPy model)."""
+        if self._np is None:
+            return None
+        return self._np.joint_origins(np.asarray(q, dtype=float).reshape(-1, self.dof))
 
     def _fk_pk(self, q) -> np.ndarray:
         m = self.chain.forward_kinematics(self._q(q)).get_matrix()

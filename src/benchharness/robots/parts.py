@@ -127,6 +127,10 @@ class RobotArm:
     def jacobian(self, q) -> np.ndarray:
         return self.chain.jacobian(q)
 
+    def joint_origins(self, q) -> np.ndarray | None:
+        """Origins of the arm's movable joints (B, K, 3) in its base-link frame (None: not available)."""
+        return self.chain.joint_origins(q)
+
     def ik(
         self,
         targets: np.ndarray,

@@ -89,6 +89,9 @@ class Hand:
         None  #: the commanded tool pose of the last grip (retreats go back from it)
     )
     depth: int = 0  #: slabs the current grip covers (0: not holding)
+    #: the grip just chosen is on another arm branch (a posture found backwards from a hand-over turn):
+    #: its stand-off is reached by the detour, the posture changed away from the cube (:meth:`transit`)
+    far_posture: bool = False
     state: Any = None  #: the grasp module's own per-hand state (:meth:`GraspModule.hand_state`)
     log: list = field(default_factory=list)
 
@@ -443,8 +446,12 @@ class BimanualRubiksMachine:
         duration: float | None = None,
         settle: float = 0.2,
         seed_q: np.ndarray | None = None,
+        slack: float | None = None,
     ) -> None:
-        """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors."""
+        """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors.
+
+        ``slack``: for this move, as ``ik_slack`` (the larger of the two applies): a via point in free
+        space that the arm may miss by that much."""
         res = hand.arm.move_to_pose(
             self.actual(hand, target, self.noise()),
             duration=duration,
@@ -462,7 +469,7 @@ class BimanualRubiksMachine:
                 message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
                 f"its {label} target (joint error {res.final_joint_error:.3f} rad)",
             )
-        slack = self.config.ik_slack
+        slack = max((v for v in (self.config.ik_slack, slack) if v is not None), default=None)
         if not res.ik_success and slack is not None and res.pos_error <= slack:
             self.ctx.recorder.event(
                 "warning",
@@ -577,6 +584,68 @@ class BimanualRubiksMachine:
             worst[live] = np.where(reached, np.maximum(worst[live], jump), np.inf)
             q[live] = res.q
         return total, worst
+
+    def turn_postures(
+        self, hand: Hand, base: Pose, grips: list[Pose], axis: str, angle: float, n_seeds: int
+    ) -> tuple[list[int], np.ndarray]:
+        """Arm postures from which each of ``grips`` carries the hand-over turn, found backwards.
+
+        For every grip, ``n_seeds`` starts drawn uniformly over the arm's joint range (a continuous
+        joint over one turn about where it is) from ``plan_rng`` are solved for the end of the giver's retreat
+        (``handover_retreat`` back from the turned grip); from each solution the chain is solved
+        backwards, each pose seeded with the last solution: the retreat's 2 cm steps (each joint
+        path checked clear of the cube with the grasp module's ``hand_points``, as made forwards),
+        then the turn's waypoints back to the grip. A chain with every step smooth
+        (``max_waypoint_jump``) gives the grip's IK solution at its start. Returns (index into
+        ``grips``, solution) of every chain that passed.
+
+        Why: :meth:`turn_travel` solves the turn forwards from postures near the arm's joints, so
+        it only finds the branch the arm is near. Measured (SAPIEN Rubiks-1-20 sensor-aided seed 0,
+        the right hand's take before a -90 deg turn about x): all 14 grips (2 placements x 7 seeds
+        near the joints, upper-arm roll at -3.3 rad) ended the turn with the upper-arm roll on its
+        soft limit (-3.75 rad) and the retreat's 6 cm step switched the forearm roll 1.7 rad; the
+        giver slid out 2 cm, its re-grip found no clear way round and turned the cube 41 deg.
+        Solved backwards from starts over the whole range, 299 of 300 chains passed, their grips
+        near an upper-arm roll of -1.1 rad.
+        """
+        cfg = self.config
+        n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
+        points = self._hand_points()
+        m = max(1, math.ceil(cfg.handover_retreat / 0.02 - 1e-9))
+        # a continuous joint over the turn centred on where it is (IK keeps it on the seed's branch:
+        # drawn over [-pi, pi], a wrist roll wound to 12 rad by the twists was unwound 9.7 rad)
+        q_now = hand.arm.positions()
+        lo = np.where(np.isfinite(hand.arm.lower), hand.arm.lower, q_now - math.pi)
+        hi = np.where(np.isfinite(hand.arm.upper), hand.arm.upper, q_now + math.pi)
+        owner = np.repeat(np.arange(len(grips)), n_seeds)
+        q = lo + self.plan_rng.random((len(owner), lo.size)) * (hi - lo)
+        live = np.ones(len(owner), dtype=bool)
+        # (waypoint of the turn, retreat distance) of each pose, from the retreat's end back to the grip
+        steps = [(n, cfg.handover_retreat * j / m) for j in range(m, 0, -1)]
+        steps += [(i, 0.0) for i in range(n, -1, -1)]
+        for s, (i, back) in enumerate(steps):
+            rows = np.flatnonzero(live)
+            if rows.size == 0:
+                break
+            poses = [
+                rotate_about_point(grips[owner[r]], self.est.p, axis, angle * i / n) for r in rows
+            ]
+            if back > 0:
+                poses = [self.back_off(p, back) for p in poses]
+            res = hand.arm.ik(
+                np.stack([(base.inv() * p).as_matrix() for p in poses]), seed_q=q[rows]
+            )
+            bad = ~np.asarray(res.success, dtype=bool)
+            if s > 0:
+                bad |= np.max(np.abs(res.q - q[rows]), axis=1) > cfg.max_waypoint_jump
+                if points is not None and steps[s - 1][1] > 0:  # a retreat step, made forwards
+                    for j, r in enumerate(rows):
+                        if not bad[j]:
+                            bad[j] = not self._clears(hand, res.q[j], q[r], points)
+            q[rows] = res.q
+            live[rows[bad]] = False
+        keep = np.flatnonzero(live)
+        return [int(owner[r]) for r in keep], q[keep]
 
     def _swing(self, hand: Hand, far: Pose, label: str, seed_q: np.ndarray | None = None) -> None:
         """Carry a free hand round the cube to the stand-off ``far`` on an arc about the believed centre.
@@ -701,7 +770,13 @@ class BimanualRubiksMachine:
         return out
 
     def transit(
-        self, hand: Hand, target: Pose, *, label: str, seed_q: np.ndarray | None = None
+        self,
+        hand: Hand,
+        target: Pose,
+        *,
+        label: str,
+        seed_q: np.ndarray | None = None,
+        detour: bool = False,
     ) -> None:
         """Move a free hand to the stand-off ``target`` without sweeping it through the cube.
 
@@ -715,6 +790,11 @@ class BimanualRubiksMachine:
         straight way out is not clear, the swing is checked from where the hand is), and
         a ``detour`` event is recorded. If none does, the direct move is made and
         a warning recorded.
+
+        ``detour``: take the detour even if the direct move clears (a change of arm branch: the
+        direct move is a swing of the whole arm, its tracking off the checked joint path; measured,
+        PyBullet Rubiks-1-5 dead-reckoning-exact seed 0: a 3.7 rad stand-off move checked 23 mm
+        clear put the palm on the cube at 52 N and turned it 18 deg).
         """
         cfg = self.config
         points = self._hand_points()
@@ -724,7 +804,7 @@ class BimanualRubiksMachine:
         q0 = hand.arm.positions()
         plan_seed = q0 if seed_q is None else seed_q
         q1 = self._ik_q(hand, target, plan_seed)
-        if q1 is None or self._clears(hand, q0, q1, points):
+        if q1 is None or (not detour and self._clears(hand, q0, q1, points)):
             self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
             return
         clear = self.sweep_clearance(hand, q0, q1, points)
@@ -755,10 +835,22 @@ class BimanualRubiksMachine:
                 clearance_mm=round(1000 * clear, 1),
                 distance_m=d,
                 straight_out=bool(leg_out),
+                **({"branch_change": True} if detour else {}),
             )
             for way, q in leg_out:
                 self.send(hand, way, label=f"{label} detour out", settle=0.02, seed_q=q)
-            self.send(hand, turned, label=f"{label} detour turn", settle=0.02, seed_q=qb)
+            # a via point in free space, at least the detour's distance from the cube: it was solved for
+            # the believed pose; the injected calibration can put the arm's target just out of reach
+            # (measured: 11.7 mm short at 25 cm, PyBullet Rubiks-1-20 sensor-aided seed 0), which
+            # within ``sweep_clearance`` leaves the detour's clearance argument intact
+            self.send(
+                hand,
+                turned,
+                label=f"{label} detour turn",
+                settle=0.02,
+                seed_q=qb,
+                slack=cfg.sweep_clearance,
+            )
             for k, (way, q) in enumerate(leg_in):
                 last = k == len(leg_in) - 1
                 self.send(
@@ -768,6 +860,10 @@ class BimanualRubiksMachine:
                     settle=0.05 if last else 0.02,
                     seed_q=q,
                 )
+            return
+        start = self.sweep_clearance(hand, q0, q0, points, n=1)
+        if detour and clear >= min(cfg.sweep_clearance, start):  # no detour, but the move clears
+            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
             return
         self.ctx.recorder.event(
             "warning",
@@ -1101,7 +1197,11 @@ class BimanualRubiksMachine:
         pose, q_plan = grasp.choose(self, hand, req)
         grasp.ready(self, hand, req)
         far = self.back_off(pose, self.config.far_distance)
-        if (
+        if hand.far_posture:
+            # another arm branch: change posture away from the cube (the detour), not on an arc round it
+            hand.far_posture = False
+            self.transit(hand, far, label=f"{label} stand-off", seed_q=q_plan, detour=True)
+        elif (
             np.linalg.norm(far.p - hand.cmd.p) > 0.01
             or abs(float(np.dot(far.q, hand.cmd.q))) < 0.999
         ):

@@ -84,8 +84,18 @@ class PR2RubiksConfig(BimanualConfig):
     finger_preference: str = "parallel"
     #: extra IK seeds (random self-motions of the 7-DOF arm) a giver's grip is also solved from: a
     #: hand-over turn may be smooth only from another elbow/shoulder posture. The seeds come from a
-    #: generator seeded with the number of events recorded so far (deterministic per trial).
+    #: generator spawned once from the trial's rng (the machine's ``plan_rng``; deterministic per trial).
     giver_seeds: int = 6
+    #: when no grip solved from those seeds carries the hand-over turn and the giver's retreat smoothly:
+    #: starts per finger placement, drawn over the whole joint range, from which the turn is solved
+    #: backwards from the retreat's end (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`).
+    #: The seeds near the arm's joints find only the branch it is on (measured: every one of 14 ended a
+    #: turn with the upper-arm roll on its soft limit, SAPIEN Rubiks-1-20). 0: the least bad grip instead.
+    giver_backward_seeds: int = 8
+    #: a grip posture whose upper arm or forearm comes nearer the other (holding) arm than this (m), both
+    #: modelled as 5 cm round their axes, is not chosen while another is (the arms collide in the engines:
+    #: measured, a hand-over take stopped 25 mm short against the giver's elbow, PyBullet Rubiks-1-20).
+    arm_clearance: float = 0.01
     #: pre-touch (sensor-aided): std of the prior handed to the filter at each re-localisation, position
     #: (m) and yaw (deg): of the order of the head camera's error (4 mm, 3 deg) that dead reckoning carries.
     pretouch_prior_pos_std: float = 0.006

@@ -39,6 +39,46 @@ __all__ = [
 ]
 
 
+#: radius (m) of the wrist flex link's collision sphere, centred on the wrist roll axis at the palm
+#: link's origin (robots/descriptions/pr2.py): rigid with the tool frame whatever the wrist roll
+WRIST_RADIUS = 0.035
+
+
+#: radius (m) round the segments shoulder lift -> elbow -> wrist flex within which the PR2's arm lies
+#: (the elbow flex link's sphere is 5 cm; the upper-arm and forearm boxes are 9 and 8 cm square)
+ARM_RADIUS = 0.05
+
+
+def _arm_points(hand: Hand, q: np.ndarray) -> np.ndarray | None:
+    """Points (world, m) on the arm's axis from the shoulder lift through the elbow to the wrist flex at
+    joints ``q`` (one row per configuration: (B, 13, 3)); None if the arm has no joint-origin model."""
+    o = hand.arm.joint_origins(np.atleast_2d(q))
+    if o is None:
+        return None
+    s = np.linspace(0.0, 1.0, 7)[:, None]
+    pts = np.concatenate(
+        [
+            o[:, None, 1] + s[None] * (o[:, None, 3] - o[:, None, 1]),
+            o[:, None, 3] + s[None, 1:] * (o[:, None, 5] - o[:, None, 3]),
+        ],
+        axis=1,
+    )
+    w = hand.arm.base_pose().as_matrix()
+    return np.einsum("ij,bpj->bpi", w[:3, :3], pts) + w[:3, 3]
+
+
+def arm_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
+    """Least distance (m) between ``hand``'s arm at each row of ``q`` and the other arm where it is, both
+    as ``ARM_RADIUS`` round their axes (inf: no joint-origin model)."""
+    mine = _arm_points(hand, q)
+    other = m.other(hand)
+    theirs = _arm_points(other, other.arm.positions())
+    if mine is None or theirs is None:
+        return np.full(len(np.atleast_2d(q)), np.inf)
+    d = np.linalg.norm(mine[:, :, None, :] - theirs[0][None, None, :, :], axis=-1)
+    return d.min(axis=(1, 2)) - 2 * ARM_RADIUS
+
+
 def _open_hand_points() -> np.ndarray:
     from ...robots.descriptions.pr2 import GRIPPER_MAX_OPENING, PALM_BOX, TCP_X, finger_boxes
 
@@ -46,7 +86,13 @@ def _open_hand_points() -> np.ndarray:
     g = np.linspace(-0.5, 0.5, 5)
     grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
     pts = np.concatenate([np.asarray(c) + grid * np.asarray(s) for c, s in boxes])
-    return pts - np.array([TCP_X, 0.0, 0.0])
+    # the wrist flex link's sphere (the palm frame's origin): a stand-off move that changes the arm's
+    # posture can swing the wrist through the cube with the hand itself well clear (measured: 52 N from
+    # l_wrist_flex_link, the tool frame never nearer than 125 mm, the held cube turned 90 deg; SAPIEN
+    # Rubiks-1-20 sensor-aided seed 0)
+    ball = grid * 2 * WRIST_RADIUS
+    ball = ball[np.linalg.norm(ball, axis=1) <= WRIST_RADIUS + 1e-9]
+    return np.concatenate([pts, ball]) - np.array([TCP_X, 0.0, 0.0])
 
 
 class PR2Grasp:
@@ -68,7 +114,8 @@ class PR2Grasp:
 
     def hand_points(self) -> np.ndarray:
         """Points (tool frame, m) filling the open hand's collision boxes: both pads and finger bars at
-        the 90 mm opening and the palm (:func:`...robots.descriptions.pr2.finger_boxes`); the machine keeps
+        the 90 mm opening, the palm (:func:`...robots.descriptions.pr2.finger_boxes`) and the wrist flex
+        link's sphere behind it (rigid with the tool frame: on the wrist roll axis); the machine keeps
         them clear of the cube when the free hand moves to a stand-off (``sweep_clearance``)."""
         return _open_hand_points()
 
@@ -141,6 +188,7 @@ class PR2Grasp:
                 "unreachable",
                 f"{hand.side} arm: no finger placement from {world_dir} clears the other hand",
             )
+        placements, place_bonus = list(poses), list(bonus)
         seeds = [q_now]
         if turn is not None and cfg.giver_seeds > 0:
             # a giver also tries other arm configurations (the 7-DOF arm's self-motion) for each
@@ -165,6 +213,17 @@ class PR2Grasp:
             [-0.1 * float(np.max(np.abs(res.q[i] - q_now))) + bonus[i] for i in range(len(poses))]
         )
         score[~ok] = -np.inf
+        if other.holding:
+            # the other arm holds still meanwhile: a grip posture whose elbow or forearm meets it stops
+            # short of the grip (measured: a take 25 mm short, its pads on the cube's edges, against
+            # the giver's elbow at 63 N; the cube fell when the giver let go. PyBullet Rubiks-1-20)
+            clash = ok & (arm_clearance(m, hand, res.q) < cfg.arm_clearance)
+            if clash.any() and (ok & ~clash).any():
+                m.ctx.recorder.event(
+                    "arm_clash", hand=hand.side, label=req.label, rejected=int(clash.sum())
+                )
+                ok = ok & ~clash
+                score[clash] = -np.inf
         if turn is not None:
             travel, worst = m.turn_travel(
                 hand, base, [poses[i] for i in np.flatnonzero(ok)], res.q[ok], *turn
@@ -174,7 +233,11 @@ class PR2Grasp:
             turned[np.flatnonzero(ok)] -= 0.1 * travel
             if np.isfinite(turned).any():
                 score = turned
-            else:  # the least bad: the smallest largest jump on the way
+            else:
+                found = self._backward_grip(m, hand, base, placements, place_bonus, q_now, turn)
+                if found is not None:
+                    return found
+                # the least bad: the smallest largest jump on the way
                 score[np.flatnonzero(ok)] -= worst
                 m.ctx.recorder.event(
                     "warning",
@@ -183,6 +246,53 @@ class PR2Grasp:
                 )
         best = int(np.argmax(score))
         return poses[best], np.array(res.q[best], dtype=float)
+
+    def _backward_grip(
+        self,
+        m: BimanualRubiksMachine,
+        hand: Hand,
+        base: Pose,
+        placements: list[Pose],
+        bonus: list[float],
+        q_now: np.ndarray,
+        turn: tuple[str, float],
+    ) -> tuple[Pose, np.ndarray] | None:
+        """A giver's grip whose turn and retreat run smoothly, from postures found backwards from the
+        retreat's end (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`, ``giver_backward_seeds``
+        starts per placement), when none near the arm's joints does; checked forwards again
+        (``turn_travel``) and scored as :meth:`choose` scores (joint change, finger bonus, turn travel).
+        None: none found. Recorded as a ``giver_posture`` event."""
+        n = self.config.giver_backward_seeds
+        if n <= 0:
+            return None
+        owner, qs = m.turn_postures(hand, base, placements, *turn, n_seeds=n)
+        if owner and m.other(hand).holding:
+            keep = np.flatnonzero(arm_clearance(m, hand, qs) >= self.config.arm_clearance)
+            owner, qs = [owner[j] for j in keep], qs[keep]
+        if not owner:
+            return None
+        grips = [placements[i] for i in owner]
+        travel, _ = m.turn_travel(hand, base, grips, qs, *turn)
+        score = np.array(
+            [
+                -0.1 * float(np.max(np.abs(qs[j] - q_now))) + bonus[owner[j]] - 0.1 * travel[j]
+                for j in range(len(owner))
+            ]
+        )
+        if not np.isfinite(score).any():
+            return None
+        best = int(np.argmax(score))
+        # another branch: the stand-off move changes posture away from the cube
+        hand.far_posture = True
+        m.ctx.recorder.event(
+            "giver_posture",
+            hand=hand.side,
+            chains=len(owner),
+            checked=int(np.isfinite(travel).sum()),
+            joint_change=round(float(np.max(np.abs(qs[best] - q_now))), 2),
+            travel=round(float(travel[best]), 2),
+        )
+        return grips[best], np.array(qs[best], dtype=float)
 
     def ready(self, m: BimanualRubiksMachine, hand: Hand, req: GripRequest) -> None:
         hand.gripper.open(wait=0.3)
