@@ -513,18 +513,35 @@ class Backend(abc.ABC):
         every physics step while a finger moves (~78,000 calls in a Rubiks-1-5
         trial), and normalising the arguments cost more than the engine's
         setters. A backend may therefore send only the targets when the
-        joints are already driven with exactly these gains and caps, and fall
-        back to :meth:`set_joint_targets` otherwise; this default always does.
+        joints are already driven with exactly these gains and caps
+        (:meth:`_retarget_driven`); otherwise this is :meth:`set_joint_targets`.
         """
-        self.set_joint_targets(
-            body,
-            positions,
-            velocities,
-            joints=joints,
-            stiffness=stiffness,
-            damping=damping,
-            force_limit=force_limit,
-        )
+        if not self._retarget_driven(
+            body, positions, velocities, joints, stiffness, damping, force_limit
+        ):
+            self.set_joint_targets(
+                body,
+                positions,
+                velocities,
+                joints=joints,
+                stiffness=stiffness,
+                damping=damping,
+                force_limit=force_limit,
+            )
+
+    def _retarget_driven(
+        self,
+        body: BodyId,
+        positions: Sequence[float],
+        velocities: Sequence[float],
+        joints: Sequence[str],
+        stiffness: Sequence[float],
+        damping: Sequence[float],
+        force_limit: Sequence[float],
+    ) -> bool:
+        """Engine hook of :meth:`retarget_joints`: set only the targets if the joints are driven with
+        exactly these gains and caps, and say so (False: nothing done, the full call follows)."""
+        return False
 
     def gravity_torques(self, body: BodyId) -> np.ndarray:
         """Joint torques/forces (:meth:`joint_names` order) that hold the body still against gravity.

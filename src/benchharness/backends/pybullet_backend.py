@@ -901,33 +901,24 @@ class PyBulletBackend(Backend):
             b.ones = [1.0] * len(b.driven_pb)
         b.drive_cache = None
 
-    def retarget_joints(
+    def _retarget_driven(
         self,
         body: BodyId,
         positions: Sequence[float],
         velocities: Sequence[float],
-        *,
         joints: Sequence[str],
         stiffness: Sequence[float],
         damping: Sequence[float],
         force_limit: Sequence[float],
-    ) -> None:
+    ) -> bool:
         b = self._b(body)
         sel = b.joint_selection(joints)
         if not b.drive.holds(sel, stiffness, damping, force_limit):
-            self.set_joint_targets(
-                body,
-                positions,
-                velocities,
-                joints=joints,
-                stiffness=stiffness,
-                damping=damping,
-                force_limit=force_limit,
-            )
-            return
+            return False
         b.drive.target_q[sel] = np.asarray(positions, dtype=float)
         b.drive.target_v[sel] = np.asarray(velocities, dtype=float)
         b.drive_cache = None
+        return True
 
     def set_joint_friction(
         self, body: BodyId, torques: float | Sequence[float], joints: Sequence[str] | None = None

@@ -539,53 +539,40 @@ class SapienBackend(Backend):
         q, v, k, d, f = cmd.q, cmd.v, cmd.k, cmd.d, cmd.f
         # PhysX keeps drive settings until changed: only changed values are sent (a held robot
         # re-sends the same targets every control tick, and each setter is a C++ call)
-        props, targets = b.drive_props, b.drive_targets
-        for i, qi, vi, ki, di, fi in zip(
-            sel.tolist(), q.tolist(), v.tolist(), k.tolist(), d.tolist(), f.tolist()
-        ):
-            j = b.sjoints[i]
+        props = b.drive_props
+        idx = sel.tolist()
+        for i, ki, di, fi in zip(idx, k.tolist(), d.tolist(), f.tolist()):
             prop = (ki, di, fi)
             if props.get(i) != prop:
-                j.set_drive_property(*prop, "force")
+                b.sjoints[i].set_drive_property(*prop, "force")
                 props[i] = prop
-            last = targets.get(i)
-            if last is None or last[0] != qi:
-                j.set_drive_target(qi)
-            if last is None or last[1] != vi:
-                j.set_drive_velocity_target(vi)
-            targets[i] = (qi, vi)
+        self._send_targets(b, idx, q.tolist(), v.tolist())
 
-    def retarget_joints(
+    def _retarget_driven(
         self,
         body: BodyId,
         positions: Sequence[float],
         velocities: Sequence[float],
-        *,
         joints: Sequence[str],
         stiffness: Sequence[float],
         damping: Sequence[float],
         force_limit: Sequence[float],
-    ) -> None:
+    ) -> bool:
         b = self._b(body)
         sel = b.joint_selection(joints)
         if not b.drive.holds(sel, stiffness, damping, force_limit):
-            self.set_joint_targets(
-                body,
-                positions,
-                velocities,
-                joints=joints,
-                stiffness=stiffness,
-                damping=damping,
-                force_limit=force_limit,
-            )
-            return
+            return False
         q = np.asarray(positions, dtype=float)
         v = np.asarray(velocities, dtype=float)
         b.drive.target_q[sel], b.drive.target_v[sel] = q, v
+        self._send_targets(b, sel.tolist(), q.tolist(), v.tolist())
+        return True
+
+    @staticmethod
+    def _send_targets(b: _Body, sel: list[int], q: list[float], v: list[float]) -> None:
+        """Position and velocity targets to PhysX, only those that changed (each setter is a C++ call)."""
         targets = b.drive_targets
-        for i, qi, vi in zip(
-            sel.tolist(), q.tolist(), v.tolist()
-        ):  # as set_joint_targets sends them
+        for i, qi, vi in zip(sel, q, v):
             j = b.sjoints[i]
             last = targets.get(i)
             if last is None or last[0] != qi:
