@@ -19,6 +19,9 @@ import numpy as np
 from benchharness.runner import trial as trial_mod
 from benchharness.runner.spec import RunSpec
 
+#: the three fingertips a Level I grasp uses (index, middle, thumb)
+TIPS = ("link_3_tip", "link_7_tip", "link_15_tip")
+
 
 def main() -> None:
     ap = argparse.ArgumentParser()
@@ -102,19 +105,15 @@ def main() -> None:
                     pen[ct.link_b] = min(pen.get(ct.link_b, 0.0), float(ct.distance))
                 else:
                     other += ct.normal_force
-            tips = " ".join(
-                f"{k[5:]}={f.get(k, 0.0):5.2f}" for k in ("link_3_tip", "link_7_tip", "link_15_tip")
-            )
+            tips = " ".join(f"{k[5:]}={f.get(k, 0.0):5.2f}" for k in TIPS)
             d = (c - st["c0"]) * 1e3
             rows.append(
                 f"t={t:6.3f} {st['phase']:8s} dCoM_palm[mm]=({d[0]:6.1f},{d[1]:6.1f},{d[2]:6.1f}) "
                 f"|v|={np.linalg.norm(v):5.3f} N: {tips} other={other:5.2f}"
             )
+            if args.slip or args.normals:  # fingertip centres in the world, for either report
+                tips_w = {k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3] for k in TIPS}
             if args.slip:
-                tips_w = {
-                    k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3]
-                    for k in ("link_3_tip", "link_7_tip", "link_15_tip")
-                }
                 in_obj = {k: (np.linalg.inv(ob) @ np.append(p, 1.0))[:3] for k, p in tips_w.items()}
                 if st["phase"] == "released" and "tips0" not in st:
                     st["tips0"] = in_obj
@@ -136,16 +135,12 @@ def main() -> None:
                     f"max|q-q_target|={err.max():.3f} rad (joint {used[int(err.argmax())]})"
                 )
             if args.normals:
-                tw = {
-                    k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3]
-                    for k in ("link_3_tip", "link_7_tip", "link_15_tip")
-                }
-                g = np.mean(list(tw.values()), axis=0)
+                g = np.mean(list(tips_w.values()), axis=0)
                 for k in sorted(nrm):
                     n = nrm[k] / max(np.linalg.norm(nrm[k]), 1e-12)
                     # the squeeze direction (towards the fingertip centroid) against the contact
                     # normal: outside the friction cone (45 deg at mu = 1) the squeeze slides
-                    sq = palm[:3, :3].T @ (g - tw[k])
+                    sq = palm[:3, :3].T @ (g - tips_w[k])
                     ang = np.degrees(np.arccos(np.clip(n @ sq / np.linalg.norm(sq), -1.0, 1.0)))
                     rows.append(
                         f"      {k}: normal(palm)=({n[0]:5.2f},{n[1]:5.2f},{n[2]:5.2f}) "
