@@ -282,9 +282,7 @@ def _sweep(spec, store, workers, trial_sel, retry_failed, progress, video=None):
     from ..plugin import PluginNotFoundError
     from ..runner.sweep import default_workers, run_sweep
 
-    workers = default_workers() if workers is None else workers
-    if workers < 0:
-        fail("--workers must be 0 or more")
+    workers = default_workers() if workers is None else workers  # checked by _spec
     show = sys.stderr.isatty() if progress is None else progress
     bar = _Progress(show, f"{spec.task} {spec.strategy}/{spec.robot}/{spec.backend}")
     try:
