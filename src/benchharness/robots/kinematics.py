@@ -76,6 +76,14 @@ def _pk() -> Any:
     return pk
 
 
+def restart_stream(generator: Any, seed: int) -> Any:
+    """The generator restarts are drawn from: the caller's, else a :class:`UniformStream` at ``seed``.
+
+    Built only where restarts are drawn (a seeded IK call that converges draws none).
+    """
+    return generator if generator is not None else UniformStream(seed)
+
+
 def _uniform(generator: Any, n: int, dof: int) -> np.ndarray:
     """``n`` x ``dof`` uniforms from a :class:`UniformStream` or a ``torch.Generator``."""
     if isinstance(generator, UniformStream):
@@ -451,10 +459,8 @@ class KinematicChain:
             return self._np.fk_jacobian(qa)[0]
         return self._fk_pk(qa)
 
-    def joint_origins(self, q) -> np.ndarray | None:
-        """Origins of the movable joints (B, K, 3) in the root frame (None: the chain has no NumPy model)."""
-        if self._np is None:
-            return None
+    def joint_origins(self, q) -> np.ndarray:
+        """Origins of the movable joints (B, K, 3) in the root frame."""
         return self._np.joint_origins(np.asarray(q, dtype=float).reshape(-1, self.dof))
 
     def _fk_pk(self, q) -> np.ndarray:
@@ -502,7 +508,6 @@ class KinematicChain:
         restarts. Deterministic for a given seed/generator state.
         """
         tgt = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
-        gen = generator if generator is not None else UniformStream(seed)
         ref = (
             None
             if seed_q is None
@@ -515,7 +520,7 @@ class KinematicChain:
             miss = np.flatnonzero(~first.success)
             if miss.size == 0:
                 return first
-            rest = self._ik_restarts(tgt[miss], ref[miss], gen, config)
+            rest = self._ik_restarts(tgt[miss], ref[miss], restart_stream(generator, seed), config)
             better = rest.success | (
                 rest.pos_error + 0.1 * rest.rot_error
                 < first.pos_error[miss] + 0.1 * first.rot_error[miss]
@@ -534,7 +539,7 @@ class KinematicChain:
                 rest.rot_error[better],
             )
             return IKResult(q, ok, dp, dr)
-        return self._ik_restarts(tgt, ref, gen, config)
+        return self._ik_restarts(tgt, ref, restart_stream(generator, seed), config)
 
     def _ik_seeded(self, tgt: np.ndarray, ref: np.ndarray, config: IKConfig) -> IKResult:
         """Damped least squares from the seed alone, per target, stopping at convergence (NumPy)."""

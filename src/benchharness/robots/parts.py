@@ -18,7 +18,14 @@ import numpy as np
 from ..backends.interface import BodyId
 from ..geometry import Pose
 from .config import ArmConfig, GripperConfig
-from .kinematics import IKConfig, IKResult, KinematicChain, UniformStream, pose_error
+from .kinematics import (
+    IKConfig,
+    IKResult,
+    KinematicChain,
+    UniformStream,
+    pose_error,
+    restart_stream,
+)
 from .trajectory import QuinticTrajectory
 
 if TYPE_CHECKING:
@@ -127,8 +134,8 @@ class RobotArm:
     def jacobian(self, q) -> np.ndarray:
         return self.chain.jacobian(q)
 
-    def joint_origins(self, q) -> np.ndarray | None:
-        """Origins of the arm's movable joints (B, K, 3) in its base-link frame (None: not available)."""
+    def joint_origins(self, q) -> np.ndarray:
+        """Origins of the arm's movable joints (B, K, 3) in its base-link frame."""
         return self.chain.joint_origins(q)
 
     def ik(
@@ -258,7 +265,7 @@ class RobotArm:
         Jacobian-transpose-pseudoinverse of the position rows only.
         """
         t = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
-        gen = generator if generator is not None else UniformStream(seed)
+        gen = restart_stream(generator, seed)
         b = t.shape[0]
         best_q = np.zeros((b, self.chain.dof))
         best_e = np.full(b, np.inf)

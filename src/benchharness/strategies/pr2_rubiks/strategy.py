@@ -49,12 +49,10 @@ WRIST_RADIUS = 0.035
 ARM_RADIUS = 0.05
 
 
-def _arm_points(hand: Hand, q: np.ndarray) -> np.ndarray | None:
+def _arm_points(hand: Hand, q: np.ndarray) -> np.ndarray:
     """Points (world, m) on the arm's axis from the shoulder lift through the elbow to the wrist flex at
-    joints ``q`` (one row per configuration: (B, 13, 3)); None if the arm has no joint-origin model."""
+    joints ``q`` (one row per configuration: (B, 13, 3))."""
     o = hand.arm.joint_origins(np.atleast_2d(q))
-    if o is None:
-        return None
     s = np.linspace(0.0, 1.0, 7)[:, None]
     pts = np.concatenate(
         [
@@ -73,8 +71,6 @@ def arm_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.nda
     mine = _arm_points(hand, q)
     other = m.other(hand)
     theirs = _arm_points(other, other.arm.positions())
-    if mine is None or theirs is None:
-        return np.full(len(np.atleast_2d(q)), np.inf)
     d = np.linalg.norm(mine[:, :, None, :] - theirs[0][None, None, :, :], axis=-1)
     return d.min(axis=(1, 2)) - 2 * ARM_RADIUS
 
