@@ -43,9 +43,11 @@ class BimanualConfig:
     #: wrist at its 7 cm pre-grasp can sweep the 57 mm cube).
     far_distance: float = 0.15
     #: a free hand's joint-space move to its stand-off, and a retreat, must keep the hand this far (m) from
-    #: the believed cube all the way (one that starts nearer: at most 5 mm nearer than it starts), checked
-    #: on the straight joint path with forward kinematics and the grasp module's ``hand_points``; a
-    #: stand-off move that comes nearer backs out first (``detour_distances``), a retreat is cut short.
+    #: the believed cube and from the table all the way (one that starts nearer: at most 5 mm nearer than
+    #: it starts), checked on the straight joint path with forward kinematics and the grasp module's
+    #: ``hand_points``; a stand-off move that comes nearer backs out first (``detour_distances``), a
+    #: retreat is cut short. The table counts since a stand-off swing checked against the cube alone
+    #: drove the PR2's wrist into the table's edge (SAPIEN Rubiks-1-50 sensor-aided seed 0).
     #: Why: a stand-off
     #: whose IK solution lies on another arm branch is reached by a joint-space swing of the whole hand;
     #: measured (PR2, PyBullet, Rubiks-5-5 sensor-aided seed 0 trial 5): a shift-in stand-off move turning

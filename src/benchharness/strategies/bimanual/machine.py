@@ -248,10 +248,11 @@ class BimanualRubiksMachine:
         self.b = b
         b.add_ground()
         h = cfg.table_height
-        tx, ty = cfg.table_half_size
+        centre, (tx, ty, tz) = self.table_box()
+        wood = (0.55, 0.40, 0.26, 1.0)  # in a video
         b.add_body(
-            [Box((tx, ty, h / 2), rgba=(0.55, 0.40, 0.26, 1.0))],  # wood, in a video
-            Pose(np.array([cfg.cube_xy[0], cfg.cube_xy[1], h / 2])),
+            [Box((float(tx), float(ty), float(tz)), rgba=wood)],
+            Pose(centre),
             1.0,
             fixed=True,
             name="table",
@@ -724,17 +725,33 @@ class BimanualRubiksMachine:
         res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
         return np.asarray(res.q[0], dtype=float) if bool(res.success[0]) else None
 
+    def table_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The table (a fixed box from the floor to ``table_height``, world axes): centre and half extents (m)."""
+        cfg = self.config
+        h = cfg.table_height
+        tx, ty = cfg.table_half_size
+        return np.array([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]), np.array([tx, ty, h / 2])
+
     def sweep_clearance(
         self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int = 16
     ) -> float:
-        """Least distance (m) from the believed cube (a box) of the hand's ``points`` (tool frame) along
-        the straight joint path ``q0`` -> ``q1`` (the path :meth:`RobotArm.move_to_joints` tracks)."""
+        """Least distance (m) of the hand's ``points`` (tool frame) along the straight joint path
+        ``q0`` -> ``q1`` (the path :meth:`RobotArm.move_to_joints` tracks) from what the hand must not
+        touch: the believed cube (a box) and the table (:meth:`table_box`, where the scene put it).
+
+        Why the table: the twisting pose is 7 cm above the table top and the cube drifts down over a
+        long tier; a free hand's joint-space swing to its stand-off checked clear of the cube drove the
+        wrist into the table's edge at 295 N, where the arm stuck 258 mm from its target, and the
+        re-grip closed on nothing (SAPIEN Rubiks-1-50 sensor-aided seed 0, move 38)."""
         s = np.linspace(0.0, 1.0, n)[:, None]
         t = np.asarray(hand.arm.fk(q0 + s * (q1 - q0)), dtype=float)
         w = hand.arm.base_pose().as_matrix() @ t
-        p = np.einsum("nij,pj->npi", w[:, :3, :3], points) + w[:, None, :3, 3]
-        local = self.est.rotation.inv().apply(p.reshape(-1, 3) - self.est.p)
-        return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - CUBE_HALF, 0.0), axis=1)))
+        p = (np.einsum("nij,pj->npi", w[:, :3, :3], points) + w[:, None, :3, 3]).reshape(-1, 3)
+        local = self.est.rotation.inv().apply(p - self.est.p)
+        cube = np.min(np.linalg.norm(np.maximum(np.abs(local) - CUBE_HALF, 0.0), axis=1))
+        centre, half = self.table_box()
+        table = np.min(np.linalg.norm(np.maximum(np.abs(p - centre) - half, 0.0), axis=1))
+        return float(min(cube, table))
 
     def _hand_points(self) -> np.ndarray | None:
         """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
