@@ -192,17 +192,21 @@ class NotAnOutcomeStrategy:
 
 
 class InhandNoisyStrategy:
-    """Reaches the desired pose with rng noise; drops the object 20 % of the time."""
+    """Reaches the desired pose with rng noise; drops the object 20 % of the time.
+
+    Trial k reports a planning time of 0.1 k s, dropped or not.
+    """
 
     benchmarks = ("inhand",)
 
     def run_trial(self, ctx):
         ctx.backend.step(2)
+        plan_time_s = 0.1 * ctx.trial_index
         if ctx.rng.random() < 0.2:
-            return TrialOutcome(dropped=True, message="slipped (test)")
+            return TrialOutcome(dropped=True, message="slipped (test)", plan_time_s=plan_time_s)
         reached = np.array(ctx.item.desired, float)
         reached[:3] += ctx.rng.normal(0, 0.005, 3)
-        return TrialOutcome(reached=reached, plan_time_s=0.5, exec_time_s=1.67)
+        return TrialOutcome(reached=reached, plan_time_s=plan_time_s, exec_time_s=1.67)
 
 
 @dataclass(frozen=True)

@@ -173,6 +173,18 @@ def test_inhand_run_and_tables(invoke):
     assert {row["method"] for row in data["table2"] if row["source"] == "paper"} >= {
         "relaxed-rigidity"
     }
+    # planning time: the median over every trial that planned, drops included (0.1 k s for trial k)
+    assert ours[0]["plan_time_s"] == pytest.approx(float(np.median(0.1 * np.arange(1, 21))))
+    paper_plan = {
+        row["method"]: row["plan_time_s"] for row in data["table2"] if row["source"] == "paper"
+    }
+    assert paper_plan == {
+        "point-contact": 14.8,
+        "ik-rigid": 4.4,
+        "relaxed-position": 0.5,
+        "relaxed-position-orientation": 0.3,
+        "relaxed-rigidity": 0.5,
+    }
     t3 = data["table3"]
     assert {row["object"] for row in t3} == {
         "gelatin box",
@@ -183,6 +195,7 @@ def test_inhand_run_and_tables(invoke):
     assert all(row["paper"]["err_pos_cm"] > 0 for row in t3)
     text = invoke(table, "--benchmark", "inhand").output
     assert "relaxed-rigidity" in text and "gelatin box [gelatin_box-dmg2]" in text
+    assert "plan time (s)" in text and "14.80" in text and "1.05" in text
 
 
 @pytest.mark.skipif(

@@ -708,6 +708,7 @@ def table(
                 ("err_pos%", "right"),
                 ("err_or%", "right"),
                 ("other failures", "right"),
+                ("plan time (s)", "right"),
             ):
                 t.add_column(c, justify=j)
             for r in t2:
@@ -720,6 +721,7 @@ def table(
                     _fmt(r.get("err_pos_percent")),
                     _fmt(r.get("err_or_percent")),
                     str(r.get("failed_other", "")),
+                    _fmt(r.get("plan_time_s")),
                 )
             print_table(t, console)
             methods: dict[str, list] = {}

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-__all__ = ["TABLE_II", "TABLE_III", "TABLE_III_ROWS"]
+__all__ = ["PLAN_TIME_S", "TABLE_II", "TABLE_III", "TABLE_III_ROWS"]
 
 #: method -> {drops_percent, err_pos_cm, err_pos_percent, err_or_percent}
 TABLE_II: Mapping[str, Mapping[str, float]] = {
@@ -40,6 +40,16 @@ TABLE_II: Mapping[str, Mapping[str, float]] = {
         "err_pos_percent": 28.67,
         "err_or_percent": 9.86,
     },
+}
+
+#: method -> median planning time (s) across all objects, Level I on the Allegro
+#: (Sec. IV-A2's text, not Table II; IK-rigid was planned but not run on the robot)
+PLAN_TIME_S: Mapping[str, float] = {
+    "point-contact": 14.8,
+    "ik-rigid": 4.4,
+    "relaxed-position": 0.5,
+    "relaxed-position-orientation": 0.3,
+    "relaxed-rigidity": 0.5,
 }
 
 #: Table III rows in print order: key -> label

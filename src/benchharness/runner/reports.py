@@ -28,7 +28,7 @@ from ..cube import get_tier, load_tiers
 from ..cube.tiers import UnknownTierError
 from ..metrics import TrialScores, mean_and_std, score_trials, summarize_scores
 from .causes import TrialStatus
-from .published import TABLE_II, TABLE_III
+from .published import PLAN_TIME_S, TABLE_II, TABLE_III
 from .store import StoredTrial, group_by_run
 
 __all__ = [
@@ -292,10 +292,30 @@ def _median(stats, name: str, scale: float = 1.0) -> float | None:
     return None if s.n == 0 else float(s.median * scale)
 
 
+def _plan_time_medians(trials: Sequence[StoredTrial], col_of) -> dict[str, float]:
+    """Per method label: median ``plan_time_s`` over every trial that recorded one.
+
+    Planning comes before the set-up, so discarded, dropped and failed trials
+    planned too (the paper's "median planning time across all objects").
+    """
+    by: dict[str, list[float]] = {}
+    for t in trials:
+        v = t.outcome.get("plan_time_s")
+        if v is not None and np.isfinite(float(v)):
+            by.setdefault(col_of[t.run_key].label, []).append(float(v))
+    return {k: float(np.median(v)) for k, v in by.items()}
+
+
 def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
-    """Table II rows: ours (one per method) then the paper's, with ``source``."""
+    """Table II rows: ours (one per method) then the paper's, with ``source``.
+
+    ``plan_time_s`` is the median planning time (every trial that planned;
+    the paper's figure from its text, where it gives one).
+    """
     scored, other = _scorable(trials)
-    columns, col_of = _columns([t for t in trials if t.benchmark == "inhand"])
+    inhand = [t for t in trials if t.benchmark == "inhand"]
+    columns, col_of = _columns(inhand)
+    plan_times = _plan_time_medians(inhand, col_of)
     rows: list[dict[str, Any]] = []
     if scored:
         a, s = _score_stored(scored)
@@ -313,6 +333,7 @@ def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
                     "err_pos_percent": _median(g.stats, "err_pos_percent"),
                     "err_or_percent": _median(g.stats, "err_or_percent"),
                     "failed_other": sum(col_of[t.run_key].label == label for t in other),
+                    "plan_time_s": plan_times.get(label),
                 }
             )
     for label in {col_of[t.run_key].label for t in other} - {r["method"] for r in rows}:
@@ -327,10 +348,22 @@ def inhand_table2(trials: Sequence[StoredTrial]) -> list[dict[str, Any]]:
                 "err_pos_percent": None,
                 "err_or_percent": None,
                 "failed_other": sum(col_of[t.run_key].label == label for t in other),
+                "plan_time_s": plan_times.get(label),
             }
         )
     for method, v in TABLE_II.items():
-        rows.append({"source": "paper", "method": method, **dict(v)})
+        rows.append(
+            {"source": "paper", "method": method, **dict(v), "plan_time_s": PLAN_TIME_S.get(method)}
+        )
+    for method in sorted(PLAN_TIME_S.keys() - TABLE_II.keys()):  # planned, not run on the robot
+        rows.append(
+            {
+                "source": "paper",
+                "method": method,
+                **{k: None for k in next(iter(TABLE_II.values()))},
+                "plan_time_s": PLAN_TIME_S[method],
+            }
+        )
     return rows
 
 
