@@ -451,14 +451,28 @@ class BimanualRubiksMachine:
         """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors.
 
         ``slack``: for this move, as ``ik_slack`` (the larger of the two applies): a via point in free
-        space that the arm may miss by that much."""
+        space that the arm may miss by that much. Without a slack, a target whose IK does not converge
+        fails `unreachable` before the arm moves: the IK's best attempt for a target just out of reach
+        can be a restart on another arm branch (measured, SAPIEN Rubiks-5-20 sensor-aided seed 0 trial
+        5: a pre-touch sweep's start 2 mm out of reach with the injected errors, the elbow straight,
+        swung the upper-arm and forearm rolls -2.84 / +2.86 rad into the cube held by the other hand
+        alone, 72 N; the sweep, which catches the failure and skips, had already moved)."""
+        slack = max((v for v in (self.config.ik_slack, slack) if v is not None), default=None)
         res = hand.arm.move_to_pose(
             self.actual(hand, target, self.noise()),
             duration=duration,
             velocity_scale=self.config.velocity_scale,
             settle=settle,
             seed_q=seed_q,
+            move_unsolved=slack is not None,
         )
+        if not res.ik_success and slack is None:
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: no IK solution for {label} "
+                f"(target {np.round(target.p, 3).tolist()}; the IK's best is "
+                f"{1000 * res.pos_error:.1f} mm, {math.degrees(res.rot_error):.1f}° from it; not moved)",
+            )
         hand.cmd = target
         if hand.holding:
             hand.last_grip = target
@@ -469,7 +483,6 @@ class BimanualRubiksMachine:
                 message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
                 f"its {label} target (joint error {res.final_joint_error:.3f} rad)",
             )
-        slack = max((v for v in (self.config.ik_slack, slack) if v is not None), default=None)
         if not res.ik_success and slack is not None and res.pos_error <= slack:
             self.ctx.recorder.event(
                 "warning",
