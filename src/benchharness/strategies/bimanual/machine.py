@@ -1209,7 +1209,7 @@ class BimanualRubiksMachine:
         grasp = self.grasp
         pose, q_plan = grasp.choose(self, hand, req)
         grasp.ready(self, hand, req)
-        far = self.back_off(pose, self.config.far_distance)
+        far = self.standoff(hand, pose, q_plan, label)
         if hand.far_posture:
             # another arm branch: change posture away from the cube (the detour), not on an arc round it
             hand.far_posture = False
@@ -1226,6 +1226,63 @@ class BimanualRubiksMachine:
         hand.cube_in_tcp = hand.cmd.inv() * self.est
         hand.grip_dir, hand.depth = world_dir, depth
         self._judge(label, hand)
+
+    def reach_margin(self) -> tuple[float, float]:
+        """How far (m, rad) a target must stay reachable either way along (about) each world axis:
+        ``standoff_reach_sigmas`` standard deviations of the injected per-motion position error
+        (calibration and tracking together) and of the calibration's rotation (0: none injected)."""
+        err, k = self.config.errors, self.config.standoff_reach_sigmas or 0.0
+        return k * math.hypot(err.calib_pos_std, err.tracking_std), k * math.radians(
+            err.calib_rot_std_deg
+        )
+
+    def reachable(self, hand: Hand, pose: Pose, seed: np.ndarray) -> bool:
+        """Whether ``pose`` (believed) and its neighbours within :meth:`reach_margin` (moved either way
+        along each world axis, turned either way about each) all have an IK solution from ``seed``:
+        whatever the injected errors put the arm's target within that box, it stays reachable."""
+        dp, dr = self.reach_margin()
+        poses = [pose]
+        for axis in np.eye(3):
+            for s in (1.0, -1.0):
+                if dp > 0:
+                    poses.append(Pose(pose.p + s * dp * axis, pose.q))
+                if dr > 0:
+                    turn = Rotation.from_rotvec(s * dr * axis)
+                    poses.append(Pose.from_rotation(pose.p, turn * pose.rotation))
+        base = hand.arm.base_pose()
+        # in batches small enough that the restarts of the misses stay in the NumPy solver
+        for i in range(0, len(poses), 7):
+            rows = np.stack([(base.inv() * p).as_matrix() for p in poses[i : i + 7]])
+            if not np.asarray(hand.arm.ik(rows, seed_q=seed).success, dtype=bool).all():
+                return False
+        return True
+
+    def standoff(self, hand: Hand, grip: Pose, q_plan: np.ndarray | None, label: str) -> Pose:
+        """The stand-off a free hand comes to before it moves in to ``grip``: ``far_distance`` back along
+        the approach or, with ``standoff_reach_sigmas``, the farthest of that and 2 cm steps in (to
+        ``retreat_distance``) that stays :meth:`reachable` from the grip's solution ``q_plan`` (a
+        ``standoff`` event when it is not the first; if none is, ``far_distance`` and a warning)."""
+        cfg = self.config
+        far = self.back_off(grip, cfg.far_distance)
+        if cfg.standoff_reach_sigmas is None:
+            return far
+        seed = hand.arm.positions() if q_plan is None else np.asarray(q_plan, dtype=float)
+        n = max(0, math.floor((cfg.far_distance - cfg.retreat_distance) / 0.02 + 1e-9))
+        for i in range(n + 1):
+            d = cfg.far_distance - 0.02 * i
+            cand = far if i == 0 else self.back_off(grip, d)
+            if self.reachable(hand, cand, seed):
+                if i > 0:
+                    self.ctx.recorder.event(
+                        "standoff", hand=hand.side, label=label, distance_m=round(d, 3)
+                    )
+                return cand
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: no stand-off for the {label} within the arm's reach with the "
+            f"injected errors' margin; {100 * cfg.far_distance:.0f} cm",
+        )
+        return far
 
     def _next_turn(self, k: int | None, side: str) -> tuple[str, float] | None:
         """If ``side``'s next regrasp after action ``k`` is giving the cube in a hand-over: (axis, angle)."""
