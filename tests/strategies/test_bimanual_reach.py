@@ -141,7 +141,7 @@ def test_standoff_comes_in_until_reachable_with_the_injected_errors_margin():
         {"hand": "left", "label": "t", "distance_m": round(expect, 3)},
     )
     # the old stand-off (no margin) is what the arm reaches for the believed pose alone
-    m0, Hand, grip, shoulder = _machine(standoff_reach_sigmas=None)
+    m0, Hand, grip, shoulder = _machine(reach_sigmas=None)
     hand0 = Hand("left", _SphereArm(shoulder, reach), None, Pose(np.zeros(3)), grip)
     assert m0.standoff(hand0, grip, np.zeros(7), "t").p == pytest.approx(far.p)
     # zero injected error: the margin is 0 and the 15 cm stand-off is kept

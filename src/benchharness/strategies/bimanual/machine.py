@@ -1015,9 +1015,10 @@ class BimanualRubiksMachine:
         points = self._hand_points()
 
         def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
-            """Smooth, and (with hand points) clear of the cube; the IK solution to seed the move with."""
+            """Smooth, within reach with the injected errors' margin, and (with hand points) clear of the
+            cube; the IK solution to seed the move with."""
             q1 = self.smooth_q(hand, target)
-            if q1 is None:
+            if q1 is None or not self.reachable(hand, target, q1):
                 return False, None
             if points is None:
                 return True, None
@@ -1110,15 +1111,17 @@ class BimanualRubiksMachine:
         points: np.ndarray,
         stop_on_fail: bool,
     ) -> tuple[list[tuple[Pose, np.ndarray, str]], np.ndarray, bool]:
-        """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``) and its joint
-        path clear (:meth:`_clears`): the waypoints (pose, IK solution, ``label``) that pass, the last
-        solution, and whether all passed (``stop_on_fail``: stop at the first that fails, else give up)."""
+        """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``), within reach
+        with the injected errors' margin (:meth:`reachable`) and its joint path clear (:meth:`_clears`):
+        the waypoints (pose, IK solution, ``label``) that pass, the last solution, and whether all passed
+        (``stop_on_fail``: stop at the first that fails, else give up)."""
         out: list[tuple[Pose, np.ndarray, str]] = []
         for way in poses:
             q1 = self._ik_q(hand, way, q)
             if (
                 q1 is None
                 or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
+                or not self.reachable(hand, way, q1)
                 or not self._clears(hand, q, q1, points)
             ):
                 if stop_on_fail:
@@ -1229,9 +1232,9 @@ class BimanualRubiksMachine:
 
     def reach_margin(self) -> tuple[float, float]:
         """How far (m, rad) a target must stay reachable either way along (about) each world axis:
-        ``standoff_reach_sigmas`` standard deviations of the injected per-motion position error
+        ``reach_sigmas`` standard deviations of the injected per-motion position error
         (calibration and tracking together) and of the calibration's rotation (0: none injected)."""
-        err, k = self.config.errors, self.config.standoff_reach_sigmas or 0.0
+        err, k = self.config.errors, self.config.reach_sigmas or 0.0
         return k * math.hypot(err.calib_pos_std, err.tracking_std), k * math.radians(
             err.calib_rot_std_deg
         )
@@ -1239,7 +1242,10 @@ class BimanualRubiksMachine:
     def reachable(self, hand: Hand, pose: Pose, seed: np.ndarray) -> bool:
         """Whether ``pose`` (believed) and its neighbours within :meth:`reach_margin` (moved either way
         along each world axis, turned either way about each) all have an IK solution from ``seed``:
-        whatever the injected errors put the arm's target within that box, it stays reachable."""
+        whatever the injected errors put the arm's target within that box, it stays reachable.
+        Without ``reach_sigmas``: True (the caller has checked ``pose`` itself)."""
+        if self.config.reach_sigmas is None:
+            return True
         dp, dr = self.reach_margin()
         poses = [pose]
         for axis in np.eye(3):
@@ -1259,12 +1265,12 @@ class BimanualRubiksMachine:
 
     def standoff(self, hand: Hand, grip: Pose, q_plan: np.ndarray | None, label: str) -> Pose:
         """The stand-off a free hand comes to before it moves in to ``grip``: ``far_distance`` back along
-        the approach or, with ``standoff_reach_sigmas``, the farthest of that and 2 cm steps in (to
+        the approach or, with ``reach_sigmas``, the farthest of that and 2 cm steps in (to
         ``retreat_distance``) that stays :meth:`reachable` from the grip's solution ``q_plan`` (a
         ``standoff`` event when it is not the first; if none is, ``far_distance`` and a warning)."""
         cfg = self.config
         far = self.back_off(grip, cfg.far_distance)
-        if cfg.standoff_reach_sigmas is None:
+        if cfg.reach_sigmas is None:
             return far
         seed = hand.arm.positions() if q_plan is None else np.asarray(q_plan, dtype=float)
         n = max(0, math.floor((cfg.far_distance - cfg.retreat_distance) / 0.02 + 1e-9))

@@ -66,10 +66,11 @@ class PR2RubiksConfig(BimanualConfig):
     pregrasp_distance: float = 0.07
     #: a hand that lets go backs off to the pre-grasp stand-off (m), the way it came in.
     retreat_distance: float = 0.07
-    #: a grip's 15 cm stand-off must stay within reach for the injected errors' 3 standard deviations
-    #: (BimanualConfig): the arm's stand-off along a side approach is near full stretch (measured, PyBullet
-    #: Rubiks-1-20 sensor-aided seed 0: a shift-out stand-off out of reach with the cube drifted and tilted).
-    standoff_reach_sigmas: float | None = 3.0
+    #: a grip's 15 cm stand-off and a retreat's steps must stay within reach for the injected errors' 3
+    #: standard deviations (BimanualConfig): a side approach's stand-off and retreat are near the arm's
+    #: full stretch (measured: PyBullet Rubiks-1-20 and SAPIEN Rubiks-5-20 sensor-aided seed 0 ended
+    #: `unreachable` there).
+    reach_sigmas: float | None = 3.0
     #: grip force per finger (N), as in tests/cube_physics/rig.py and docs/benchmarks/cube_spike.md.
     grip_force: float = 20.0
     #: force per finger (N) of the first, gentle close when the other hand already holds the cube:
