@@ -110,7 +110,7 @@ class BimanualConfig:
     #: the hand-over turn also carries the cube back to ``twist_position`` (the believed centre's offset from
     #: it spread evenly over the turn's waypoints): each hand-over's belief and grip errors otherwise add up,
     #: and the cube wandered 14 mm down and 7 mm out over 10 moves until a turn left the arms' reach
-    #: (HERB, PyBullet Rubiks-1-20). False (the PR2's recorded results): the turn is about the centre only.
+    #: (HERB, PyBullet Rubiks-1-20; the PR2 too, SAPIEN Rubiks-5-20). False: the turn is about the centre only.
     recentre_turn: bool = False
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.
     handover_waypoints: int = 4
