@@ -152,3 +152,34 @@ def test_standoff_comes_in_until_reachable_with_the_injected_errors_margin():
     assert mz.reach_margin() == (0.0, 0.0)
     assert mz.standoff(hz, grip, np.zeros(7), "t").p == pytest.approx(far.p)
     assert mz.ctx.recorder.events == []
+
+
+def test_retreat_steps_stop_where_the_injected_errors_margin_leaves_the_reach():
+    """A retreat's steps (``_chain``, as ``release_hand``'s side route makes them) backing away from the
+    shoulder: each step's own IK succeeds up to the sphere, but a step whose 3-sigma margin box (computed
+    here) pokes out of it fails, and the chain stops at the last step before; without ``reach_sigmas``
+    every step the believed target reaches is taken."""
+    m, Hand, grip, shoulder = _machine()
+    err = m.config.errors
+    margin = 3.0 * np.hypot(err.calib_pos_std, err.tracking_std)
+    steps = [m.back_off(grip, 0.02 * (i + 1)) for i in range(6)]  # y = 0.05 .. 0.15, away from it
+    # the 4th step (y = 0.11, 0.51 m from the shoulder) in reach, its margin box not
+    reach = float(np.linalg.norm(steps[3].p - shoulder)) + 0.002
+    for cfg, expect in (({}, 3), ({"reach_sigmas": None}, 4)):
+        m, Hand, grip, shoulder = _machine(**cfg)
+        m._clears = lambda *a: True  # no FK model here: the sweep check is not what is tested
+        hand = Hand("left", _SphereArm(shoulder, reach), None, Pose(np.zeros(3)), grip)
+        out, _, _ = m._chain(hand, np.zeros(7), steps, "retreat step", np.zeros((1, 3)), True)
+        assert len(out) == expect
+        in_box = [
+            all(
+                np.linalg.norm(s.p + k * margin * a - shoulder) <= reach
+                for a in np.eye(3)
+                for k in (1, -1)
+            )
+            for s in steps
+        ]
+        if cfg:
+            assert in_box[:3] == [True] * 3  # the margin is not what stops the old chain
+        else:
+            assert in_box[:4] == [True, True, True, False]
