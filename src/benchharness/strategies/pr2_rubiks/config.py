@@ -68,7 +68,7 @@ class PR2RubiksConfig(BimanualConfig):
     retreat_distance: float = 0.07
     #: the hand-over turn carries the believed cube back to ``twist_position`` (BimanualConfig, as HERB's):
     #: without it the cube wandered from the pose the stand-offs and turns were placed for (SAPIEN
-    #: Rubiks-5-20 sensor-aided seed 0 trial 4: 32 mm forward and 23 mm down after 9 twists) until no
+    #: Rubiks-5-20 sensor-aided seed 0 trial 4: 32 mm forward, 12 mm left, 28 mm down after 9 twists) until no
     #: stand-off of a re-grip was within the arm's reach (`unreachable`); with it that trial succeeds.
     recentre_turn: bool = True
     #: a grip's 15 cm stand-off and a retreat's steps must stay within reach for the injected errors' 3
