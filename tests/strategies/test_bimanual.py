@@ -214,5 +214,5 @@ def test_swing_routes_and_giver_depth_are_herb_options_the_pr2_leaves_off():
 
     pr2, herb = PR2RubiksConfig(), HerbPushGraspConfig()
     assert not pr2.swing_routes and pr2.giver_depth is None and pr2.ik_slack is None
-    assert not pr2.recentre_turn and herb.recentre_turn
+    assert pr2.recentre_turn and herb.recentre_turn
     assert herb.swing_routes and herb.giver_depth == 1 and herb.ik_slack == 0.005

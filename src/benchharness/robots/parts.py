@@ -314,6 +314,7 @@ class RobotArm:
         generator: UniformStream | torch.Generator | None = None,
         seed: int = 0,
         seed_q: np.ndarray | None = None,
+        move_unsolved: bool = True,
     ) -> MotionResult:
         """Move the tool frame to a world pose: IK for the goal, then a tracked joint trajectory.
 
@@ -321,11 +322,28 @@ class RobotArm:
         the solution nearest to where it is; or with ``seed_q``, a
         configuration planned ahead (e.g. the start of a chain of solutions
         checked for a later motion), so that the arm ends on that branch.
+
+        ``move_unsolved=False``: if the IK does not converge the arm does not move (the result has
+        ``ik_success`` False, no duration, and the IK's own position and rotation errors). With the
+        default the arm moves to the IK's best attempt, which for a target just out of reach can be
+        a random restart on another arm branch (measured: upper-arm and forearm rolls swung -2.84 /
+        +2.86 rad for a target 2 mm out of reach, PR2 on SAPIEN).
         """
         base = self.base_pose()
         local = (base.inv() * target).as_matrix()
         q_now = self.positions() if seed_q is None else np.asarray(seed_q, dtype=float)
         res = self.ik(local[None], seed_q=q_now, generator=generator, seed=seed)
+        if not move_unsolved and not res.success[0]:
+            return MotionResult(
+                False,
+                np.asarray(res.q[0], dtype=float),
+                0.0,
+                0.0,
+                float("nan"),
+                float(res.pos_error[0]),
+                float(res.rot_error[0]),
+                0.0,
+            )
         motion = self.move_to_joints(
             res.q[0], duration=duration, velocity_scale=velocity_scale, settle=settle
         )

@@ -58,6 +58,20 @@ class BimanualConfig:
     #: stand-off would sweep the cube makes that move instead: straight back along its own approach to
     #: the distance, there to the stand-off's orientation (the joint-space swing), then straight in.
     detour_distances: tuple[float, ...] = (0.25, 0.35, 0.45)
+    #: a grip's stand-off and every step of a retreat must stay reachable (IK) with the target moved this
+    #: many standard deviations of the injected per-motion position error (calibration and tracking,
+    #: ``errors``) either way along each world axis, and turned as many of the calibration's rotation std
+    #: either way about each (:meth:`.machine.BimanualRubiksMachine.reachable`): the arm is sent the target
+    #: with those errors, and a target the planner found reachable only for the believed pose fails there.
+    #: A stand-off that does not comes in along the approach in 2 cm steps (to ``retreat_distance`` at
+    #: least) until one does (a ``standoff`` event); a retreat step that does not counts as one the arm
+    #: cannot follow (the retreat goes sideways or is cut, as for a joint limit). None: no margin. Why:
+    #: the cube's believed pose wanders over a tier (PR2, PyBullet Rubiks-1-20 sensor-aided seed 0: 13 mm
+    #: forward, 15 mm left, 12 mm down and the work axis tilted 8 deg after 19 twists), and a 15 cm
+    #: stand-off along the tilted approach left the stretched arm's reach (elbow flex on its limit: 18.9 mm
+    #: short for the believed target, 22.2 mm for the sent one); a retreat step reachable for the believed
+    #: target was 21 mm short with the errors (SAPIEN Rubiks-5-20 trial 4). Both ended `unreachable`.
+    reach_sigmas: float | None = None
     #: a retreat whose straight way out fails (a joint limit, another branch beyond) may instead slide the
     #: open hand sideways, across its approach and finger axes (the pads slide along the faces they
     #: touched, away from the other hand), at most this far (m), after backing off as far as the straight
@@ -98,7 +112,7 @@ class BimanualConfig:
     #: the hand-over turn also carries the cube back to ``twist_position`` (the believed centre's offset from
     #: it spread evenly over the turn's waypoints): each hand-over's belief and grip errors otherwise add up,
     #: and the cube wandered 14 mm down and 7 mm out over 10 moves until a turn left the arms' reach
-    #: (HERB, PyBullet Rubiks-1-20). False (the PR2's recorded results): the turn is about the centre only.
+    #: (HERB, PyBullet Rubiks-1-20; the PR2 too, SAPIEN Rubiks-5-20). False: the turn is about the centre only.
     recentre_turn: bool = False
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.
     handover_waypoints: int = 4

@@ -452,14 +452,28 @@ class BimanualRubiksMachine:
         """Command ``hand`` to ``target`` (believed); the arm receives it with the injected errors.
 
         ``slack``: for this move, as ``ik_slack`` (the larger of the two applies): a via point in free
-        space that the arm may miss by that much."""
+        space that the arm may miss by that much. Without a slack, a target whose IK does not converge
+        fails `unreachable` before the arm moves: the IK's best attempt for a target just out of reach
+        can be a restart on another arm branch (measured, SAPIEN Rubiks-5-20 sensor-aided seed 0 trial
+        5: a pre-touch sweep's start 2 mm out of reach with the injected errors, the elbow straight,
+        swung the upper-arm and forearm rolls -2.84 / +2.86 rad into the cube held by the other hand
+        alone, 72 N; the sweep, which catches the failure and skips, had already moved)."""
+        slack = max((v for v in (self.config.ik_slack, slack) if v is not None), default=None)
         res = hand.arm.move_to_pose(
             self.actual(hand, target, self.noise()),
             duration=duration,
             velocity_scale=self.config.velocity_scale,
             settle=settle,
             seed_q=seed_q,
+            move_unsolved=slack is not None,
         )
+        if not res.ik_success and slack is None:
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: no IK solution for {label} "
+                f"(target {np.round(target.p, 3).tolist()}; the IK's best is "
+                f"{1000 * res.pos_error:.1f} mm, {math.degrees(res.rot_error):.1f}° from it; not moved)",
+            )
         hand.cmd = target
         if hand.holding:
             hand.last_grip = target
@@ -470,7 +484,6 @@ class BimanualRubiksMachine:
                 message=f"{hand.side} arm ended {1000 * res.pos_error:.1f} mm from "
                 f"its {label} target (joint error {res.final_joint_error:.3f} rad)",
             )
-        slack = max((v for v in (self.config.ik_slack, slack) if v is not None), default=None)
         if not res.ik_success and slack is not None and res.pos_error <= slack:
             self.ctx.recorder.event(
                 "warning",
@@ -1019,9 +1032,10 @@ class BimanualRubiksMachine:
         points = self._hand_points()
 
         def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
-            """Smooth, and (with hand points) clear of the cube; the IK solution to seed the move with."""
+            """Smooth, within reach with the injected errors' margin, and (with hand points) clear of the
+            cube; the IK solution to seed the move with."""
             q1 = self.smooth_q(hand, target)
-            if q1 is None:
+            if q1 is None or not self.reachable(hand, target, q1):
                 return False, None
             if points is None:
                 return True, None
@@ -1114,15 +1128,17 @@ class BimanualRubiksMachine:
         points: np.ndarray,
         stop_on_fail: bool,
     ) -> tuple[list[tuple[Pose, np.ndarray, str]], np.ndarray, bool]:
-        """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``) and its joint
-        path clear (:meth:`_clears`): the waypoints (pose, IK solution, ``label``) that pass, the last
-        solution, and whether all passed (``stop_on_fail``: stop at the first that fails, else give up)."""
+        """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``), within reach
+        with the injected errors' margin (:meth:`reachable`) and its joint path clear (:meth:`_clears`):
+        the waypoints (pose, IK solution, ``label``) that pass, the last solution, and whether all passed
+        (``stop_on_fail``: stop at the first that fails, else give up)."""
         out: list[tuple[Pose, np.ndarray, str]] = []
         for way in poses:
             q1 = self._ik_q(hand, way, q)
             if (
                 q1 is None
                 or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
+                or not self.reachable(hand, way, q1)
                 or not self._clears(hand, q, q1, points)
             ):
                 if stop_on_fail:
@@ -1213,7 +1229,7 @@ class BimanualRubiksMachine:
         grasp = self.grasp
         pose, q_plan = grasp.choose(self, hand, req)
         grasp.ready(self, hand, req)
-        far = self.back_off(pose, self.config.far_distance)
+        far = self.standoff(hand, pose, q_plan, label)
         if hand.far_posture:
             # another arm branch: change posture away from the cube (the detour), not on an arc round it
             hand.far_posture = False
@@ -1230,6 +1246,66 @@ class BimanualRubiksMachine:
         hand.cube_in_tcp = hand.cmd.inv() * self.est
         hand.grip_dir, hand.depth = world_dir, depth
         self._judge(label, hand)
+
+    def reach_margin(self) -> tuple[float, float]:
+        """How far (m, rad) a target must stay reachable either way along (about) each world axis:
+        ``reach_sigmas`` standard deviations of the injected per-motion position error
+        (calibration and tracking together) and of the calibration's rotation (0: none injected)."""
+        err, k = self.config.errors, self.config.reach_sigmas or 0.0
+        return k * math.hypot(err.calib_pos_std, err.tracking_std), k * math.radians(
+            err.calib_rot_std_deg
+        )
+
+    def reachable(self, hand: Hand, pose: Pose, seed: np.ndarray) -> bool:
+        """Whether ``pose`` (believed) and its neighbours within :meth:`reach_margin` (moved either way
+        along each world axis, turned either way about each) all have an IK solution from ``seed``:
+        whatever the injected errors put the arm's target within that box, it stays reachable.
+        Without ``reach_sigmas``: True (the caller has checked ``pose`` itself)."""
+        if self.config.reach_sigmas is None:
+            return True
+        dp, dr = self.reach_margin()
+        poses = [pose]
+        for axis in np.eye(3):
+            for s in (1.0, -1.0):
+                if dp > 0:
+                    poses.append(Pose(pose.p + s * dp * axis, pose.q))
+                if dr > 0:
+                    turn = Rotation.from_rotvec(s * dr * axis)
+                    poses.append(Pose.from_rotation(pose.p, turn * pose.rotation))
+        base = hand.arm.base_pose()
+        # in batches small enough that the restarts of the misses stay in the NumPy solver
+        for i in range(0, len(poses), 7):
+            rows = np.stack([(base.inv() * p).as_matrix() for p in poses[i : i + 7]])
+            if not np.asarray(hand.arm.ik(rows, seed_q=seed).success, dtype=bool).all():
+                return False
+        return True
+
+    def standoff(self, hand: Hand, grip: Pose, q_plan: np.ndarray | None, label: str) -> Pose:
+        """The stand-off a free hand comes to before it moves in to ``grip``: ``far_distance`` back along
+        the approach or, with ``reach_sigmas``, the farthest of that and 2 cm steps in (to
+        ``retreat_distance``) that stays :meth:`reachable` from the grip's solution ``q_plan`` (a
+        ``standoff`` event when it is not the first; if none is, ``far_distance`` and a warning)."""
+        cfg = self.config
+        far = self.back_off(grip, cfg.far_distance)
+        if cfg.reach_sigmas is None:
+            return far
+        seed = hand.arm.positions() if q_plan is None else np.asarray(q_plan, dtype=float)
+        n = max(0, math.floor((cfg.far_distance - cfg.retreat_distance) / 0.02 + 1e-9))
+        for i in range(n + 1):
+            d = cfg.far_distance - 0.02 * i
+            cand = far if i == 0 else self.back_off(grip, d)
+            if self.reachable(hand, cand, seed):
+                if i > 0:
+                    self.ctx.recorder.event(
+                        "standoff", hand=hand.side, label=label, distance_m=round(d, 3)
+                    )
+                return cand
+        self.ctx.recorder.event(
+            "warning",
+            message=f"{hand.side}: no stand-off for the {label} within the arm's reach with the "
+            f"injected errors' margin; {100 * cfg.far_distance:.0f} cm",
+        )
+        return far
 
     def _next_turn(self, k: int | None, side: str) -> tuple[str, float] | None:
         """If ``side``'s next regrasp after action ``k`` is giving the cube in a hand-over: (axis, angle)."""

@@ -66,6 +66,16 @@ class PR2RubiksConfig(BimanualConfig):
     pregrasp_distance: float = 0.07
     #: a hand that lets go backs off to the pre-grasp stand-off (m), the way it came in.
     retreat_distance: float = 0.07
+    #: the hand-over turn carries the believed cube back to ``twist_position`` (BimanualConfig, as HERB's):
+    #: without it the cube wandered from the pose the stand-offs and turns were placed for (SAPIEN
+    #: Rubiks-5-20 sensor-aided seed 0 trial 4: 32 mm forward, 12 mm left, 28 mm down after 9 twists) until no
+    #: stand-off of a re-grip was within the arm's reach (`unreachable`); with it that trial succeeds.
+    recentre_turn: bool = True
+    #: a grip's 15 cm stand-off and a retreat's steps must stay within reach for the injected errors' 3
+    #: standard deviations (BimanualConfig): a side approach's stand-off and retreat are near the arm's
+    #: full stretch (measured: PyBullet Rubiks-1-20 and SAPIEN Rubiks-5-20 sensor-aided seed 0 ended
+    #: `unreachable` there).
+    reach_sigmas: float | None = 3.0
     #: grip force per finger (N), as in tests/cube_physics/rig.py and docs/benchmarks/cube_spike.md.
     grip_force: float = 20.0
     #: force per finger (N) of the first, gentle close when the other hand already holds the cube:
