@@ -867,12 +867,21 @@ class BimanualRubiksMachine:
                 straight_out=bool(leg_out),
                 **({"branch_change": True} if detour else {}),
             )
+            # the way out and the turn are via points in free space, moving away from the cube: they
+            # were solved for the believed pose; the injected calibration can put the arm's target just
+            # out of reach (measured: 11.7 mm short at 25 cm, PyBullet Rubiks-1-20 sensor-aided seed 0;
+            # a way-out step 0.9 mm short, seeded on its planned chain, once an unconverged move was no
+            # longer made, PyBullet Rubiks-1-20 at 66b020b), which within ``sweep_clearance`` leaves the
+            # detour's clearance argument intact
             for way, q in leg_out:
-                self.send(hand, way, label=f"{label} detour out", settle=0.02, seed_q=q)
-            # a via point in free space, at least the detour's distance from the cube: it was solved for
-            # the believed pose; the injected calibration can put the arm's target just out of reach
-            # (measured: 11.7 mm short at 25 cm, PyBullet Rubiks-1-20 sensor-aided seed 0), which
-            # within ``sweep_clearance`` leaves the detour's clearance argument intact
+                self.send(
+                    hand,
+                    way,
+                    label=f"{label} detour out",
+                    settle=0.02,
+                    seed_q=q,
+                    slack=cfg.sweep_clearance,
+                )
             self.send(
                 hand,
                 turned,
