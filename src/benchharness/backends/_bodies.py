@@ -116,21 +116,29 @@ class DriveState:
         self.kp[sel], self.kd[sel], self.fmax[sel] = cmd.k, cmd.d, cmd.f
         self.driven[sel] = True
 
-    def holds(
+    def retarget(
         self,
         sel: np.ndarray,
+        positions: Sequence[float],
+        velocities: Sequence[float],
         stiffness: Sequence[float],
         damping: Sequence[float],
         force_limit: Sequence[float],
     ) -> bool:
-        """Joints ``sel`` are driven with exactly these gains and (finite) caps: a re-target needs
-        only new targets (:meth:`benchharness.backends.Backend.retarget_joints`)."""
-        return (
+        """New targets for joints ``sel`` if they are driven with exactly these gains and (finite)
+        caps, and say so; False: nothing set (the full :meth:`set_targets` is needed). Each engine's
+        ``_retarget_driven`` hook (:meth:`benchharness.backends.Backend.retarget_joints`) is this
+        and whatever its engine must be told."""
+        if not (
             bool(self.driven[sel].all())
             and self.kp[sel].tolist() == list(stiffness)
             and self.kd[sel].tolist() == list(damping)
             and self.fmax[sel].tolist() == list(force_limit)
-        )
+        ):
+            return False
+        self.target_q[sel] = np.asarray(positions, dtype=float)
+        self.target_v[sel] = np.asarray(velocities, dtype=float)
+        return True
 
     def efforts(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The capped drive law at ``(q, v)``, ``-sign(v) friction`` for undriven joints.

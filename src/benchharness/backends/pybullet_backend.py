@@ -913,10 +913,8 @@ class PyBulletBackend(Backend):
     ) -> bool:
         b = self._b(body)
         sel = b.joint_selection(joints)
-        if not b.drive.holds(sel, stiffness, damping, force_limit):
+        if not b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit):
             return False
-        b.drive.target_q[sel] = np.asarray(positions, dtype=float)
-        b.drive.target_v[sel] = np.asarray(velocities, dtype=float)
         b.drive_cache = None
         return True
 

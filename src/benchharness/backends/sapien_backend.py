@@ -560,12 +560,11 @@ class SapienBackend(Backend):
     ) -> bool:
         b = self._b(body)
         sel = b.joint_selection(joints)
-        if not b.drive.holds(sel, stiffness, damping, force_limit):
+        if not b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit):
             return False
-        q = np.asarray(positions, dtype=float)
-        v = np.asarray(velocities, dtype=float)
-        b.drive.target_q[sel], b.drive.target_v[sel] = q, v
-        self._send_targets(b, sel.tolist(), q.tolist(), v.tolist())
+        self._send_targets(
+            b, sel.tolist(), b.drive.target_q[sel].tolist(), b.drive.target_v[sel].tolist()
+        )
         return True
 
     @staticmethod
