@@ -204,6 +204,11 @@ class GraspModule(Protocol):
         ...
 
 
+def _box_gap(local: np.ndarray, half: np.ndarray | float) -> float:
+    """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
+    return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=1)))
+
+
 class BimanualRubiksMachine:
     """Rubik's strategy for a two-armed robot; its grasp primitives are ``grasp``'s (see the module docstring).
 
@@ -760,11 +765,11 @@ class BimanualRubiksMachine:
         t = np.asarray(hand.arm.fk(q0 + s * (q1 - q0)), dtype=float)
         w = hand.arm.base_pose().as_matrix() @ t
         p = (np.einsum("nij,pj->npi", w[:, :3, :3], points) + w[:, None, :3, 3]).reshape(-1, 3)
-        local = self.est.rotation.inv().apply(p - self.est.p)
-        cube = np.min(np.linalg.norm(np.maximum(np.abs(local) - CUBE_HALF, 0.0), axis=1))
         centre, half = self.table_box()
-        table = np.min(np.linalg.norm(np.maximum(np.abs(p - centre) - half, 0.0), axis=1))
-        return float(min(cube, table))
+        return min(
+            _box_gap(self.est.rotation.inv().apply(p - self.est.p), CUBE_HALF),
+            _box_gap(p - centre, half),
+        )
 
     def _hand_points(self) -> np.ndarray | None:
         """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
@@ -1302,7 +1307,7 @@ class BimanualRubiksMachine:
         n = max(0, math.floor((cfg.far_distance - cfg.retreat_distance) / 0.02 + 1e-9))
         for i in range(n + 1):
             d = cfg.far_distance - 0.02 * i
-            cand = far if i == 0 else self.back_off(grip, d)
+            cand = self.back_off(grip, d)
             if self.reachable(hand, cand, seed):
                 if i > 0:
                     self.ctx.recorder.event(
