@@ -162,22 +162,26 @@ def run_options(f: Callable) -> Callable:
 
 
 def _spec(
-    task,
-    robot,
-    strategy,
-    backend,
-    seed,
-    sensors,
-    repeats,
-    physics_kv,
-    sim_budget,
-    wall_budget,
-    plugins,
-    strategy_kv=(),
-    trial_sel=None,
-    workers=None,
+    *,
+    task: str,
+    robot: str,
+    strategy: str,
+    backend: str,
+    seed: int,
+    sensors: str | None,
+    repeats: int,
+    physics_kv: tuple[str, ...],
+    sim_budget: float | None,
+    wall_budget: float | None,
+    plugins: tuple[str, ...],
+    strategy_kv: tuple[str, ...] = (),
+    trial_sel: str | None = None,
+    workers: int | None = None,
 ):
-    """The run's :class:`RunSpec`, every argument checked before a store is opened (exit 2 naming one)."""
+    """The run's :class:`RunSpec`, every argument checked before a store is opened (exit 2 naming one).
+
+    Keyword-only: ``run`` and ``compare`` pass fourteen of the same click values, and a swapped pair
+    of positional ones (two budgets, two tuples) would not fail, only mis-run."""
     from ..plugin import PluginNotFoundError
     from ..runner.contract import TimeBudget
     from ..runner.options import normalise_options
@@ -470,20 +474,20 @@ def run(
       benchharness run --task Rubiks-5-5 --robot pr2 --strategy sensor-aided --strategy-option pretouch_mode=grid
     """
     spec = _spec(
-        task,
-        robot,
-        strategy,
-        backend,
-        seed,
-        sensors,
-        repeats,
-        physics_kv,
-        sim_budget,
-        wall_budget,
-        plugins,
-        strategy_kv,
-        trial_sel,
-        workers,
+        task=task,
+        robot=robot,
+        strategy=strategy,
+        backend=backend,
+        seed=seed,
+        sensors=sensors,
+        repeats=repeats,
+        physics_kv=physics_kv,
+        sim_budget=sim_budget,
+        wall_budget=wall_budget,
+        plugins=plugins,
+        strategy_kv=strategy_kv,
+        trial_sel=trial_sel,
+        workers=workers,
     )
     video = None
     if video_path is not None:
@@ -808,20 +812,20 @@ def compare(
     # every backend's run checked before the store is opened
     specs = [
         _spec(
-            task,
-            robot,
-            strategy,
-            b,
-            seed,
-            sensors,
-            repeats,
-            physics_kv,
-            sim_budget,
-            wall_budget,
-            plugins,
-            strategy_kv,
-            trial_sel,
-            workers,
+            task=task,
+            robot=robot,
+            strategy=strategy,
+            backend=b,
+            seed=seed,
+            sensors=sensors,
+            repeats=repeats,
+            physics_kv=physics_kv,
+            sim_budget=sim_budget,
+            wall_budget=wall_budget,
+            plugins=plugins,
+            strategy_kv=strategy_kv,
+            trial_sel=trial_sel,
+            workers=workers,
         )
         for b in names
     ]
