@@ -12,6 +12,7 @@ pre-grasp, grip) and the two-stage close of the parallel gripper.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -75,7 +76,10 @@ def arm_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.nda
     return d.min(axis=(1, 2)) - 2 * ARM_RADIUS
 
 
+@functools.cache
 def _open_hand_points() -> np.ndarray:
+    """The open hand's points (tool frame): constants of the gripper's description, so built once and
+    returned read-only (every free-hand path check asks for them)."""
     from ...robots.descriptions.pr2 import GRIPPER_MAX_OPENING, PALM_BOX, TCP_X, finger_boxes
 
     boxes = [*finger_boxes(GRIPPER_MAX_OPENING), PALM_BOX]
@@ -88,7 +92,9 @@ def _open_hand_points() -> np.ndarray:
     # Rubiks-1-20 sensor-aided seed 0)
     ball = grid * 2 * WRIST_RADIUS
     ball = ball[np.linalg.norm(ball, axis=1) <= WRIST_RADIUS + 1e-9]
-    return np.concatenate([pts, ball]) - np.array([TCP_X, 0.0, 0.0])
+    out = np.concatenate([pts, ball]) - np.array([TCP_X, 0.0, 0.0])
+    out.setflags(write=False)
+    return out
 
 
 class PR2Grasp:
