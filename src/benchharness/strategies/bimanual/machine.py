@@ -579,7 +579,7 @@ class BimanualRubiksMachine:
         so the nearest one to the turned orientation is the turned nearest one): its rotation vector
         turned by the full turn. Why: each hand-over's belief and grip errors tilt the believed cube a
         little and nothing brought it back: its offset from faces-level reached 26 deg by twist 33 of
-        PyBullet Rubiks-1-50 and 19 deg by twist 82 of SAPIEN Rubiks-1-100 (sensor-aided seed 0), its
+        PyBullet Rubiks-1-50 and 21 deg by twist 82 of SAPIEN Rubiks-1-100 (sensor-aided seed 0), its
         grips' stand-offs tilted with it out of the arm's reach (docs/strategies.md, "Edge of reach").
         """
         cfg = self.config

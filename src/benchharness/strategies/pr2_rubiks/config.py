@@ -73,7 +73,7 @@ class PR2RubiksConfig(BimanualConfig):
     recentre_turn: bool = True
     #: the hand-over turn also brings the believed cube's orientation back to faces-level (BimanualConfig):
     #: with the position alone brought back, the believed cube's offset from faces-level grew to 26 deg by
-    #: twist 33 of PyBullet Rubiks-1-50 and 19 deg by twist 82 of SAPIEN Rubiks-1-100 (sensor-aided seed 0),
+    #: twist 33 of PyBullet Rubiks-1-50 and 21 deg by twist 82 of SAPIEN Rubiks-1-100 (sensor-aided seed 0),
     #: and each trial ended `unreachable` at a stand-off 55-61 mm, 13 deg out of reach. HERB leaves it off.
     recentre_tilt: bool = True
     #: a grip's 15 cm stand-off and a retreat's steps must stay within reach for the injected errors' 3
