@@ -3,6 +3,7 @@ made, and a grip's stand-off keeps a margin for the injected errors (docs/strate
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -183,3 +184,98 @@ def test_retreat_steps_stop_where_the_injected_errors_margin_leaves_the_reach():
             assert in_box[:3] == [True] * 3  # the margin is not what stops the old chain
         else:
             assert in_box[:4] == [True, True, True, False]
+
+
+class _RecordingArm:
+    """IK that succeeds everywhere (joints at zero) and keeps every target it was asked for."""
+
+    lower = np.full(7, -1.0)
+    upper = np.full(7, 1.0)
+
+    def __init__(self):
+        self.targets = []
+
+    def base_pose(self):
+        return Pose(np.zeros(3))
+
+    def positions(self):
+        return np.zeros(7)
+
+    def ik(self, mats, seed_q=None):
+        self.targets += list(np.asarray(mats))
+        return SimpleNamespace(success=np.ones(len(mats), dtype=bool), q=np.zeros((len(mats), 7)))
+
+
+def _faces_level_offset(rotation):
+    """Angle (rad) from ``rotation`` to the nearest of the 24 axis-aligned rotations, computed here."""
+    group = Rotation.create_group("O")
+    return float(np.min((group * rotation.inv()).magnitude()))
+
+
+def test_handover_turn_brings_a_tilted_believed_cube_back_to_faces_level():
+    """``recentre_tilt`` (the PR2's): a believed cube 7 deg off faces-level and 2 cm from the twisting pose
+    ends the hand-over turn faces-level (to 1e-9 rad) with its centre at ``twist_position``, the level
+    correction i/n of the way at waypoint i; ``turn_travel`` and ``turn_postures`` ask the IK for those
+    very waypoints. A faces-level belief, or ``recentre_tilt`` off (HERB's), gives exactly the old turn:
+    about the centre, shifted back to ``twist_position``."""
+    from benchharness.strategies.bimanual.frames import rotate_about_point
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+
+    assert not HerbPushGraspConfig().recentre_tilt
+    m, Hand, grip, _ = _machine()
+    assert m.config.recentre_tilt and m.config.recentre_turn
+    twist = np.asarray(m.config.twist_position)
+    tilt = Rotation.from_euler("xyz", [5.0, -4.0, 3.0], degrees=True)
+    m.est = Pose.from_rotation(
+        twist + [0.01, -0.015, 0.008], tilt * Rotation.from_euler("z", -90, degrees=True)
+    )
+    assert np.degrees(_faces_level_offset(m.est.rotation)) > 7.0
+    grip = m.est * Pose.from_rotation([0.0, 0.03, 0.0], Rotation.from_euler("z", -90, degrees=True))
+    in_grip = grip.inv() * m.est  # the cube in the tool frame, held rigidly
+    for axis, angle in (("x", -math.pi / 2), ("z", math.pi / 2), ("x", math.pi)):
+        path = m.turn_path(axis, angle)
+        n = 8
+        cube = [path.at(grip, i, n) * in_grip for i in range(n + 1)]
+        assert _faces_level_offset(cube[-1].rotation) < 1e-9
+        assert cube[-1].p == pytest.approx(twist, abs=1e-12)
+        turn = Rotation.from_rotvec(np.eye(3)["xyz".index(axis)] * angle)
+        # the correction is the smallest one (the belief's offset from faces-level), spread evenly: i/n
+        # of its rotation vector at waypoint i
+        v = (cube[-1].rotation * (turn * m.est.rotation).inv()).as_rotvec()
+        assert np.linalg.norm(v) == pytest.approx(_faces_level_offset(m.est.rotation), abs=1e-9)
+        for i in range(n + 1):
+            turn_i = Rotation.from_rotvec(np.eye(3)["xyz".index(axis)] * angle * i / n)
+            want = Rotation.from_rotvec(v * i / n) * turn_i * m.est.rotation
+            assert (cube[i].rotation * want.inv()).magnitude() < 1e-9
+            assert cube[i].p == pytest.approx(m.est.p + (twist - m.est.p) * i / n, abs=1e-12)
+
+    # turn_travel and turn_postures plan those waypoints
+    path, n = m.turn_path("x", -math.pi / 2), m.config.handover_waypoints
+    arm = _RecordingArm()
+    hand = Hand("left", arm, None, Pose(np.zeros(3)), grip)
+    m.turn_travel(hand, Pose(np.zeros(3)), [grip], np.zeros((1, 7)), "x", -math.pi / 2, False)
+    assert len(arm.targets) == n
+    for i, t in enumerate(arm.targets, start=1):
+        assert np.array_equal(t, path.at(grip, i, n).as_matrix())
+    arm.targets.clear()
+    m._hand_points = lambda: None
+    m.plan_rng = np.random.default_rng(0)
+    m.turn_postures(hand, Pose(np.zeros(3)), [grip], "x", -math.pi / 2, n_seeds=1)
+    for i in range(n + 1):
+        want = path.at(grip, i, n).as_matrix()
+        assert any(np.array_equal(t, want) for t in arm.targets)
+
+    # no tilt to take out, or the option off: exactly the old turn
+    def old(pose, est, axis, angle, i, n):  # the turn before recentre_tilt, as _handover made it
+        turned = rotate_about_point(pose, est.p, axis, angle * i / n)
+        return Pose(turned.p + (twist - est.p) * (i / n), turned.q)
+
+    tilted = m.est
+    level = Pose.from_rotation(tilted.p, Rotation.identity())
+    for mm, est in ((m, level), (_machine(recentre_tilt=False)[0], tilted)):
+        mm.est = est
+        path = mm.turn_path("z", math.pi / 2)
+        assert not np.any(path.level)
+        for i in range(5):
+            got, want = path.at(grip, i, 4), old(grip, est, "z", math.pi / 2, i, 4)
+            assert np.array_equal(got.p, want.p) and np.array_equal(got.q, want.q)

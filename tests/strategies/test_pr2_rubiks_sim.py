@@ -102,16 +102,25 @@ def _run_cli(tmp_path, strategy: str, backend: str, task: str = "Rubiks-1-5"):
 #: intended. The reach margin and the unmoved failed move change neither (measured: rows unchanged).
 #: With the table in the free-hand check as well (both merged) the score and time are those above; the
 #: digests differ from either branch's alone (the detour event's 0.0 mm clearance).
+#: Re-recorded for the cube's tilt (issue 16, ``recentre_tilt``): the PR2's hand-over turn also brings
+#: the believed cube to faces-level. With zero error the belief is the camera's reading of the settled
+#: cube, 0.0035 deg (PyBullet) / 0.000035 deg (SAPIEN) off faces-level, which the first turn takes out;
+#: after it every correction is float round-off. And the giver postures found backwards (one here, on
+#: both engines) now carry the ``recentre_turn`` shift their forward check has (here round-off too).
+#: Each alone moves the trial: PyBullet with the postures' shift only (``recentre_tilt=false``) ends
+#: 93.175 / 98.383 s; without either it is bit for bit the old row (measured). Both still five twists
+#: as intended (was PyBullet 94.27083333333334 / 99.47916666666667 s, digest d705e9792f5a25ae;
+#: SAPIEN 87.13749999999999 / 92.32083333333333 s, digest e6f9718f3cba7047).
 REFERENCE_ROWS = {
     "pybullet": (
-        94.27083333333334,
-        99.47916666666667,
-        "d705e9792f5a25ae",
+        95.78750000000001,
+        100.99583333333334,
+        "11067dc53625b802",
     ),
     "sapien": (
-        87.13749999999999,
-        92.32083333333333,
-        "e6f9718f3cba7047",
+        87.35416666666666,
+        92.5375,
+        "37af0c7964fb2805",
     ),
 }
 

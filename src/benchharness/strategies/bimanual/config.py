@@ -114,6 +114,13 @@ class BimanualConfig:
     #: and the cube wandered 14 mm down and 7 mm out over 10 moves until a turn left the arms' reach
     #: (HERB, PyBullet Rubiks-1-20; the PR2 too, SAPIEN Rubiks-5-20). False: the turn is about the centre only.
     recentre_turn: bool = False
+    #: the hand-over turn also brings the believed cube's orientation to the nearest faces-level one (its
+    #: axes along the world's), the correction's rotation vector spread evenly over the turn's waypoints as
+    #: ``recentre_turn``'s shift is (:meth:`.machine.BimanualRubiksMachine.turn_path`): ``recentre_turn``
+    #: brings the position back but each hand-over's errors tilt the cube a little more, 26 deg off
+    #: faces-level by twist 33 of PyBullet Rubiks-1-50 (PR2, sensor-aided seed 0), and the grips' stand-offs
+    #: tilt with it out of the arm's reach. False: the turn keeps the orientation's drift.
+    recentre_tilt: bool = False
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.
     handover_waypoints: int = 4
     #: the hand that is about to hold the cube alone (the picker, a hand-over's taker) grips two slabs deep

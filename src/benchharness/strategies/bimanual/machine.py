@@ -46,7 +46,7 @@ from ..regrasp import (
     twist_move,
 )
 from .config import BimanualConfig
-from .frames import along, rotate_about_point
+from .frames import DIRECTIONS, along, rotate_about_point
 
 __all__ = [
     "BODY_AXIS_OF_FACE",
@@ -57,6 +57,8 @@ __all__ = [
     "GripRequest",
     "Hand",
     "StrategyFailure",
+    "TurnPath",
+    "level_correction",
 ]
 
 CUBE_HALF = 0.0285
@@ -99,6 +101,40 @@ class Hand:
 def _shifted(pose: Pose, shift: np.ndarray) -> Pose:
     """``pose`` translated by ``shift`` (m, world)."""
     return Pose(pose.p + shift, pose.q)
+
+
+#: the 24 rotations that keep a cube's axes along the world's (faces-level orientations)
+_FACES_LEVEL = Rotation.create_group("O")
+
+
+def level_correction(orientation: Rotation) -> np.ndarray:
+    """Rotation vector (world frame, rad) that turns ``orientation`` to the nearest faces-level one (the
+    nearest of the 24 axis-aligned rotations). Exactly zero for an orientation that is one of them."""
+    c = _FACES_LEVEL * orientation.inv()
+    return np.asarray(c[int(np.argmin(c.magnitude()))].as_rotvec(), dtype=float)
+
+
+@dataclass(frozen=True)
+class TurnPath:
+    """A hand-over turn as the giver carries it: the believed cube's rotation of ``angle`` rad about world
+    ``axis`` through ``centre``, plus the ``shift`` of its centre (``recentre_turn``) and the ``level``
+    rotation about it (``recentre_tilt``, world rotation vector) that brings it faces-level, both spread
+    evenly over the turn (fraction i/n at waypoint i of n). One object for every place a turn is planned,
+    scored or made (:meth:`BimanualRubiksMachine.turn_path`), so that the scored path is the executed one.
+    """
+
+    centre: np.ndarray
+    axis: str
+    angle: float
+    shift: np.ndarray
+    level: np.ndarray
+
+    def at(self, pose: Pose, i: int, n: int) -> Pose:
+        """``pose`` (held rigidly with the cube) at waypoint ``i`` of ``n`` of the turn."""
+        turned = rotate_about_point(pose, self.centre, self.axis, self.angle * i / n)
+        if np.any(self.level):  # the centre is where the turn left it: level the cube about it
+            turned = rotate_about_point(turned, self.centre, self.level, i / n)
+        return _shifted(turned, self.shift * (i / n))
 
 
 @dataclass(frozen=True)
@@ -533,11 +569,31 @@ class BimanualRubiksMachine:
         )
         return np.asarray(res.q[0], dtype=float) if ok else None
 
-    def _turn_shift(self) -> np.ndarray:
-        """How far a hand-over turn carries the believed cube centre besides turning it (``recentre_turn``)."""
-        if not self.config.recentre_turn:
-            return np.zeros(3)
-        return np.asarray(self.config.twist_position, dtype=float) - self.est.p
+    def turn_path(self, axis: str, angle: float) -> TurnPath:
+        """The hand-over turn of the cube as believed now: ``angle`` rad about world ``axis`` through the
+        believed centre; with ``recentre_turn`` the centre is also carried back to ``twist_position``, with
+        ``recentre_tilt`` the turned orientation is also brought to the nearest faces-level one.
+
+        The level correction is computed for the orientation before the turn and carried through it (the
+        turn by a multiple of 90 degrees about a world axis maps faces-level orientations onto each other,
+        so the nearest one to the turned orientation is the turned nearest one): its rotation vector
+        turned by the full turn. Why: each hand-over's belief and grip errors tilt the believed cube a
+        little and nothing brought it back: its offset from faces-level reached 26 deg by twist 33 of
+        PyBullet Rubiks-1-50 and 21 deg by twist 82 of SAPIEN Rubiks-1-100 (sensor-aided seed 0), its
+        grips' stand-offs tilted with it out of the arm's reach (docs/strategies.md, "Edge of reach").
+        """
+        cfg = self.config
+        shift = (
+            np.asarray(cfg.twist_position, dtype=float) - self.est.p
+            if cfg.recentre_turn
+            else np.zeros(3)
+        )
+        level = np.zeros(3)
+        if cfg.recentre_tilt:
+            v = level_correction(self.est.rotation)
+            if np.any(v):
+                level = Rotation.from_rotvec(DIRECTIONS[axis] * angle).apply(v)
+        return TurnPath(self.est.p.copy(), axis, angle, shift, level)
 
     def turn_travel(
         self,
@@ -576,6 +632,7 @@ class BimanualRubiksMachine:
         elif with_retreat:
             m = max(1, math.ceil(cfg.handover_retreat / 0.02 - 1e-9))
             steps += [(n, cfg.handover_retreat * j / m) for j in range(1, m + 1)]
+        path = self.turn_path(axis, angle)
         q = np.array(q, dtype=float)
         total = np.zeros(len(grips))
         worst = np.zeros(len(grips))
@@ -583,11 +640,7 @@ class BimanualRubiksMachine:
             live = np.flatnonzero(np.isfinite(worst))
             if live.size == 0:
                 break
-            shift = self._turn_shift() * (i / n)
-            poses = [
-                _shifted(rotate_about_point(grips[k], self.est.p, axis, angle * i / n), shift)
-                for k in live
-            ]
+            poses = [path.at(grips[k], i, n) for k in live]
             if back > 0:  # the retreat
                 poses = [self.back_off(p, back) for p in poses]
             targets = [(base.inv() * p).as_matrix() for p in poses]
@@ -642,13 +695,12 @@ class BimanualRubiksMachine:
         # (waypoint of the turn, retreat distance) of each pose, from the retreat's end back to the grip
         steps = [(n, cfg.handover_retreat * j / m) for j in range(m, 0, -1)]
         steps += [(i, 0.0) for i in range(n, -1, -1)]
+        path = self.turn_path(axis, angle)
         for s, (i, back) in enumerate(steps):
             rows = np.flatnonzero(live)
             if rows.size == 0:
                 break
-            poses = [
-                rotate_about_point(grips[owner[r]], self.est.p, axis, angle * i / n) for r in rows
-            ]
+            poses = [path.at(grips[owner[r]], i, n) for r in rows]
             if back > 0:
                 poses = [self.back_off(p, back) for p in poses]
             res = hand.arm.ik(
@@ -1498,14 +1550,13 @@ class BimanualRubiksMachine:
                 give_turn=(a.axis, angle),
             )
         self.release_hand(taker, retreat=cfg.taker_retreat)
-        centre = self.est.p.copy()
-        shift = self._turn_shift()
+        path = self.turn_path(a.axis, angle)  # the belief before the turn: send() moves it
         n = max(1, cfg.handover_waypoints) * abs(a.quarter_turns)
         start = giver.cmd
         for i in range(1, n + 1):
             self.send(
                 giver,
-                _shifted(rotate_about_point(start, centre, a.axis, angle * i / n), shift * (i / n)),
+                path.at(start, i, n),
                 label="hand-over turn",
                 settle=0.05 if i < n else 0.2,
             )

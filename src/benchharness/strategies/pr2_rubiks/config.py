@@ -71,6 +71,11 @@ class PR2RubiksConfig(BimanualConfig):
     #: Rubiks-5-20 sensor-aided seed 0 trial 4: 32 mm forward, 12 mm left, 28 mm down after 9 twists) until no
     #: stand-off of a re-grip was within the arm's reach (`unreachable`); with it that trial succeeds.
     recentre_turn: bool = True
+    #: the hand-over turn also brings the believed cube's orientation back to faces-level (BimanualConfig):
+    #: with the position alone brought back, the believed cube's offset from faces-level grew to 26 deg by
+    #: twist 33 of PyBullet Rubiks-1-50 and 21 deg by twist 82 of SAPIEN Rubiks-1-100 (sensor-aided seed 0),
+    #: and each trial ended `unreachable` at a stand-off 55-61 mm, 13 deg out of reach. HERB leaves it off.
+    recentre_tilt: bool = True
     #: a grip's 15 cm stand-off and a retreat's steps must stay within reach for the injected errors' 3
     #: standard deviations (BimanualConfig): a side approach's stand-off and retreat are near the arm's
     #: full stretch (measured: PyBullet Rubiks-1-20 and SAPIEN Rubiks-5-20 sensor-aided seed 0 ended
