@@ -186,6 +186,8 @@ class PushGrasp:
             best_score = second_score = fallback_score = -np.inf
             best_slide = second_slide = fallback_slide = 0.0
             best_q: np.ndarray | None = None  # the IK solution to reach ``best`` by, if re-seeded
+            # a giver's placements that pass the other rules: (pose, score without the arm's posture, slide)
+            give_places: list[tuple[Pose, float, float]] = []
             # diagnostic for the recorder: each candidate and why it was taken or not
             tried: list[str] = []
             lateral = cfg.holder_thumb_offset if st.shape == 2 else cfg.rotator_thumb_offset
@@ -265,6 +267,9 @@ class PushGrasp:
                         score -= 1.0
                     if score > fallback_score:
                         fallback, fallback_score, fallback_slide = pose, score, shift - lateral
+                    give_places.append(
+                        (pose, score + 0.1 * joint_move - min(margin, 0.3), shift - lateral)
+                    )
                     travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
                     if not np.isfinite(travel[0]):
                         # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
@@ -291,6 +296,11 @@ class PushGrasp:
                     best_q = q_seeded
             if reseed or not req.twist_now or best is None or best_score > -5.0:
                 break
+        if best is None and second is None and turn is not None and give_places:
+            found = self._backward_give(m, hand, base, q_now, give_places, turn)
+            if found is not None:
+                best, best_slide, best_q = found
+                tried.append("a posture found backwards from the retreat's end (giver_posture)")
         if best is None and second is not None:
             m.ctx.recorder.event(
                 "warning",
@@ -317,6 +327,59 @@ class PushGrasp:
             )
         st.slide = best_slide
         return best, best_q
+
+    def _backward_give(
+        self,
+        m: BimanualRubiksMachine,
+        hand: Hand,
+        base: Pose,
+        q_now: np.ndarray,
+        places: list[tuple[Pose, float, float]],
+        turn: tuple[str, float],
+    ) -> tuple[Pose, float, np.ndarray] | None:
+        """A giver's grip whose hand-over turn (and the retreat after it) runs smoothly from an arm
+        posture found backwards from the retreat's end, when no grip solved from the arm's joints has
+        even a smooth turn (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`,
+        ``giver_backward_seeds`` starts per placement; the PR2's giver does the same). Each chain found
+        is checked forwards again (``turn_travel``) and scored as :meth:`choose` scores a giver's grip
+        (the placement's preferences, the joint change from where the arm is, the turn's travel).
+        Returns (grip, its slide, the posture's IK solution: the arm is sent on it) or None; recorded
+        as a ``giver_posture`` event.
+
+        Why: seeded from where the arm is, IK finds only the branch it is on; measured (SAPIEN
+        Rubiks-1-20 seed 0, the hand-over after move 17, right giver, -90 deg about z): both
+        placements' turns stepped 3.3-3.7 rad, the fallback grip's turn moved the cube and the take's
+        push met no face.
+        """
+        n = self.config.giver_backward_seeds
+        if n <= 0:
+            return None
+        owner, qs = m.turn_postures(hand, base, [p for p, _, _ in places], *turn, n_seeds=n)
+        if not owner:
+            m.ctx.recorder.event("giver_posture", hand=hand.side, chains=0)
+            return None
+        grips = [places[i][0] for i in owner]
+        travel, _ = m.turn_travel(hand, base, grips, qs, *turn)
+        change = np.max(np.abs(qs - q_now), axis=1)
+        score = np.array([places[i][1] for i in owner]) - 0.1 * change - 0.1 * travel
+        m.ctx.recorder.event(
+            "giver_posture",
+            hand=hand.side,
+            chains=len(owner),
+            checked=int(np.isfinite(travel).sum()),
+            **(
+                {}
+                if not np.isfinite(score).any()
+                else {
+                    "joint_change": round(float(change[int(np.argmax(score))]), 2),
+                    "travel": round(float(travel[int(np.argmax(score))]), 2),
+                }
+            ),
+        )
+        if not np.isfinite(score).any():
+            return None
+        j = int(np.argmax(score))
+        return grips[j], places[owner[j]][2], np.asarray(qs[j], dtype=float)
 
     def _clear_lateral(
         self, m: BimanualRubiksMachine, hand: Hand, face_pose: Pose, nominal: float
