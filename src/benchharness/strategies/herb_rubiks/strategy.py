@@ -157,7 +157,8 @@ class PushGrasp:
         (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`); if no grip does, one whose
         turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not).
         Returns the IK solution to reach the grip by when the wrist had to be re-seeded for the twist
-        (see below), else None: the arm moves to the stand-off from where it is.
+        (see below) or for a giver (the solution its hand-over turn was checked from, or one found
+        backwards, :meth:`_backward_give`), else None: the arm moves to the stand-off from where it is.
         """
         cfg = self.config
         st = _st(hand)
@@ -185,7 +186,10 @@ class PushGrasp:
             fallback: Pose | None = None
             best_score = second_score = fallback_score = -np.inf
             best_slide = second_slide = fallback_slide = 0.0
-            best_q: np.ndarray | None = None  # the IK solution to reach ``best`` by, if re-seeded
+            # the IK solution to reach ``best`` by: re-seeded for the twist, or a giver's, whose hand-over
+            # turn was checked from it (``second``'s likewise)
+            best_q: np.ndarray | None = None
+            second_q: np.ndarray | None = None
             # a giver's placements that pass the other rules: (pose, score without the arm's posture, slide)
             give_places: list[tuple[Pose, float, float]] = []
             # diagnostic for the recorder: each candidate and why it was taken or not
@@ -284,6 +288,7 @@ class PushGrasp:
                         )
                         if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
                             second = pose
+                            second_q = np.asarray(res.q[0], dtype=float)
                             second_score = score - 0.1 * float(short[0])
                             second_slide = shift - lateral
                         continue
@@ -294,6 +299,13 @@ class PushGrasp:
                 if score > best_score:
                     best, best_score, best_slide = pose, score, shift - lateral
                     best_q = q_seeded
+                    if turn is not None:
+                        # a giver is sent on the solution its turn was checked from: seeded from where the
+                        # arm ends its swing instead, IK can land on another wrist branch, from which the
+                        # turn flips the wrist with the cube in hand (measured: PyBullet Rubiks-5-5 seed 0
+                        # trial 5, checked from q7 = 2.15 rad with steps <= 0.57 rad, the arm arrived at
+                        # q7 = -3.00 on its limit, the turn's 3rd waypoint moved q7 4.63 rad, the cube fell)
+                        best_q = np.asarray(res.q[0], dtype=float)
             if reseed or not req.twist_now or best is None or best_score > -5.0:
                 break
         if best is None and second is None and turn is not None and give_places:
@@ -306,7 +318,7 @@ class PushGrasp:
                 "warning",
                 message=f"{hand.side}: no grip lets the giver retreat straight after the hand-over turn",
             )
-            best, best_slide = second, second_slide
+            best, best_slide, best_q = second, second_slide, second_q
         if best is None and fallback is not None:
             m.ctx.recorder.event(
                 "warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly"
