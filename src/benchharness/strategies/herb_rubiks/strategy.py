@@ -155,10 +155,14 @@ class PushGrasp:
         ``req.turn``: this hand will give the cube in a hand-over, so the grip should let the arm
         carry that turn and the retreat after it without an IK flip
         (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`); if no grip does, one whose
-        turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not).
+        turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not);
+        if none, one from an arm posture found backwards (:meth:`_backward_give`); else the least bad.
         Returns the IK solution to reach the grip by when the wrist had to be re-seeded for the twist
-        (see below) or for a giver (the solution its hand-over turn was checked from, or one found
-        backwards, :meth:`_backward_give`), else None: the arm moves to the stand-off from where it is.
+        (see below) or for a giver's posture found backwards (:meth:`_backward_give`), else None: the
+        arm moves to the stand-off from where it is. (A giver's turn is checked from the IK solution
+        seeded with the arm's joints now, but the arm reaches the grip from where its swing ends and
+        can arrive on another branch: PyBullet Rubiks-5-5 seed 0 trial 5, docs/herb_push_grasp.md.
+        Sending every giver on its checked solution fixed that trial but cost three others.)
         """
         cfg = self.config
         st = _st(hand)
@@ -186,10 +190,7 @@ class PushGrasp:
             fallback: Pose | None = None
             best_score = second_score = fallback_score = -np.inf
             best_slide = second_slide = fallback_slide = 0.0
-            # the IK solution to reach ``best`` by: re-seeded for the twist, or a giver's, whose hand-over
-            # turn was checked from it (``second``'s likewise)
-            best_q: np.ndarray | None = None
-            second_q: np.ndarray | None = None
+            best_q: np.ndarray | None = None  # the IK solution to reach ``best`` by, if re-seeded
             # a giver's placements that pass the other rules: (pose, score without the arm's posture, slide)
             give_places: list[tuple[Pose, float, float]] = []
             # diagnostic for the recorder: each candidate and why it was taken or not
@@ -288,7 +289,6 @@ class PushGrasp:
                         )
                         if np.isfinite(short[0]) and score - 0.1 * float(short[0]) > second_score:
                             second = pose
-                            second_q = np.asarray(res.q[0], dtype=float)
                             second_score = score - 0.1 * float(short[0])
                             second_slide = shift - lateral
                         continue
@@ -299,13 +299,6 @@ class PushGrasp:
                 if score > best_score:
                     best, best_score, best_slide = pose, score, shift - lateral
                     best_q = q_seeded
-                    if turn is not None:
-                        # a giver is sent on the solution its turn was checked from: seeded from where the
-                        # arm ends its swing instead, IK can land on another wrist branch, from which the
-                        # turn flips the wrist with the cube in hand (measured: PyBullet Rubiks-5-5 seed 0
-                        # trial 5, checked from q7 = 2.15 rad with steps <= 0.57 rad, the arm arrived at
-                        # q7 = -3.00 on its limit, the turn's 3rd waypoint moved q7 4.63 rad, the cube fell)
-                        best_q = np.asarray(res.q[0], dtype=float)
             if reseed or not req.twist_now or best is None or best_score > -5.0:
                 break
         if best is None and second is None and turn is not None and give_places:
@@ -318,7 +311,7 @@ class PushGrasp:
                 "warning",
                 message=f"{hand.side}: no grip lets the giver retreat straight after the hand-over turn",
             )
-            best, best_slide, best_q = second, second_slide, second_q
+            best, best_slide = second, second_slide
         if best is None and fallback is not None:
             m.ctx.recorder.event(
                 "warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly"
