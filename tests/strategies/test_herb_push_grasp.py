@@ -227,6 +227,64 @@ def test_giver_posture_found_backwards_is_scored_and_recorded():
     assert g0._backward_give(m, hand, Pose([0, 0, 0]), q_now, places, ("z", np.pi / 2)) is None
 
 
+def test_giver_changes_to_the_checked_branch_only_when_its_turn_would_not_be_smooth():
+    """``_keep_turn_branch``: at the stand-off, a giver whose grip from here has no smooth hand-over turn
+    while the checked solution has one moves to the checked branch (a ``give_branch`` event, the
+    stand-off sent seeded with it); a smooth turn from here moves nothing."""
+    from types import SimpleNamespace
+
+    from benchharness.strategies.herb_rubiks.strategy import BarrettState, PushGrasp
+
+    here = np.zeros(7)
+    checked = np.full(7, 2.0)
+
+    class Arm:
+        def base_pose(self):
+            return Pose([0.0, 0.0, 0.0])
+
+        def positions(self):
+            return here.copy()
+
+        def ik(self, targets, seed_q):
+            # IK stays on the branch of its seed
+            q = np.atleast_2d(np.asarray(seed_q, dtype=float))
+            return SimpleNamespace(success=np.array([True]), q=q.copy())
+
+    def turn_travel(hand, base, grips, q, axis, angle, with_retreat=True):
+        smooth = bool(np.allclose(q[0], checked)) or here_smooth[0]
+        return np.array([1.0 if smooth else np.inf]), np.array([0.5 if smooth else 4.6])
+
+    sent, events, here_smooth = [], [], [False]
+    hand = SimpleNamespace(side="right", arm=Arm(), cmd=Pose([0.0, 0.0, 0.1]), state=BarrettState())
+    hand.state.turn_q = checked
+    m = SimpleNamespace(
+        turn_travel=turn_travel,
+        send=lambda h, target, **kw: sent.append((target, kw)),
+        ctx=SimpleNamespace(
+            recorder=SimpleNamespace(event=lambda kind, **kw: events.append((kind, kw)))
+        ),
+    )
+    grip, start = Pose([0.0, 0.0, 0.2]), Pose([0.0, 0.0, 0.17])
+    g = PushGrasp()
+    g._keep_turn_branch(m, hand, grip, start, ("z", -np.pi / 2), "hand-over give grip")
+    assert len(sent) == 1 and sent[0][0] is hand.cmd and np.allclose(sent[0][1]["seed_q"], checked)
+    assert events == [
+        (
+            "give_branch",
+            {
+                "hand": "right",
+                "label": "hand-over give grip",
+                "largest_step_here": 4.6,
+                "joint_change": 2.0,
+            },
+        )
+    ]
+    # the turn from here is smooth: nothing moves
+    here_smooth[0] = True
+    g._keep_turn_branch(m, hand, grip, start, ("z", -np.pi / 2), "hand-over give grip")
+    assert len(sent) == 1 and len(events) == 1
+
+
 def _herb_ctx(backend: str, sequence: str, seed: int = 0):
     """A TrialContext with HERB, built in-process as the runner builds one (tier label Rubiks-1-1)."""
     from benchharness.backends.interface import PhysicsConfig
