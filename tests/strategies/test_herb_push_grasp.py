@@ -187,6 +187,104 @@ def test_hand_over_clearance_geometry():
     assert thumb_tip_lateral(Pose([0.0, 0.0, 0.0]), distal) == pytest.approx(expect, abs=1e-9)
 
 
+def test_giver_posture_found_backwards_is_scored_and_recorded():
+    """A giver with no smooth turn from the arm's joints takes the best chain found backwards
+    (``_backward_give``: placement preference, joint change, forward-checked turn travel); none: None."""
+    from types import SimpleNamespace
+
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.strategy import PushGrasp
+
+    events: list[tuple[str, dict]] = []
+    q_now = np.zeros(7)
+    grips = [Pose([0.0, 0.0, float(i)]) for i in range(2)]
+    # chains: placement 0 twice (joint change 1.0 / 0.2 rad), placement 1 once (change 0.1)
+    qs = np.array([[1.0] + [0.0] * 6, [0.2] + [0.0] * 6, [0.1] + [0.0] * 6])
+    travel = np.array([2.0, 3.0, np.inf])  # placement 1's chain fails the forward check
+    m = SimpleNamespace(
+        ctx=SimpleNamespace(
+            recorder=SimpleNamespace(event=lambda kind, **kw: events.append((kind, kw)))
+        ),
+        turn_postures=lambda hand, base, poses, axis, angle, n_seeds: ([0, 0, 1], qs),
+        turn_travel=lambda hand, base, poses, q, axis, angle: (travel, travel),
+    )
+    g = PushGrasp(HerbPushGraspConfig())
+    hand = SimpleNamespace(side="right")
+    places = [(grips[0], 0.5, 0.0), (grips[1], 0.5, 0.004)]
+    found = g._backward_give(m, hand, Pose([0, 0, 0]), q_now, places, ("z", np.pi / 2))
+    assert found is not None
+    pose, slide, q = found
+    # scores: 0.5 - 0.1 - 0.2 = 0.2 and 0.5 - 0.02 - 0.3 = 0.18: the first chain
+    assert pose is grips[0] and slide == 0.0 and np.allclose(q, qs[0])
+    assert events[-1][0] == "giver_posture" and events[-1][1]["chains"] == 3
+    assert events[-1][1]["checked"] == 2
+    # no chain found backwards: None, recorded
+    m.turn_postures = lambda *a, **k: ([], np.zeros((0, 7)))
+    assert g._backward_give(m, hand, Pose([0, 0, 0]), q_now, places, ("z", np.pi / 2)) is None
+    assert events[-1] == ("giver_posture", {"hand": "right", "chains": 0})
+    # off
+    g0 = PushGrasp(HerbPushGraspConfig(giver_backward_seeds=0))
+    assert g0._backward_give(m, hand, Pose([0, 0, 0]), q_now, places, ("z", np.pi / 2)) is None
+
+
+def test_giver_changes_to_the_checked_branch_only_when_its_turn_would_not_be_smooth():
+    """``_keep_turn_branch``: at the stand-off, a giver whose grip from here has no smooth hand-over turn
+    while the checked solution has one moves to the checked branch (a ``give_branch`` event, the
+    stand-off sent seeded with it); a smooth turn from here moves nothing."""
+    from types import SimpleNamespace
+
+    from benchharness.strategies.herb_rubiks.strategy import BarrettState, PushGrasp
+
+    here = np.zeros(7)
+    checked = np.full(7, 2.0)
+
+    class Arm:
+        def base_pose(self):
+            return Pose([0.0, 0.0, 0.0])
+
+        def positions(self):
+            return here.copy()
+
+        def ik(self, targets, seed_q):
+            # IK stays on the branch of its seed
+            q = np.atleast_2d(np.asarray(seed_q, dtype=float))
+            return SimpleNamespace(success=np.array([True]), q=q.copy())
+
+    def turn_travel(hand, base, grips, q, axis, angle, with_retreat=True):
+        smooth = bool(np.allclose(q[0], checked)) or here_smooth[0]
+        return np.array([1.0 if smooth else np.inf]), np.array([0.5 if smooth else 4.6])
+
+    sent, events, here_smooth = [], [], [False]
+    hand = SimpleNamespace(side="right", arm=Arm(), cmd=Pose([0.0, 0.0, 0.1]), state=BarrettState())
+    hand.state.turn_q = checked
+    m = SimpleNamespace(
+        turn_travel=turn_travel,
+        send=lambda h, target, **kw: sent.append((target, kw)),
+        ctx=SimpleNamespace(
+            recorder=SimpleNamespace(event=lambda kind, **kw: events.append((kind, kw)))
+        ),
+    )
+    grip, start = Pose([0.0, 0.0, 0.2]), Pose([0.0, 0.0, 0.17])
+    g = PushGrasp()
+    g._keep_turn_branch(m, hand, grip, start, ("z", -np.pi / 2), "hand-over give grip")
+    assert len(sent) == 1 and sent[0][0] is hand.cmd and np.allclose(sent[0][1]["seed_q"], checked)
+    assert events == [
+        (
+            "give_branch",
+            {
+                "hand": "right",
+                "label": "hand-over give grip",
+                "largest_step_here": 4.6,
+                "joint_change": 2.0,
+            },
+        )
+    ]
+    # the turn from here is smooth: nothing moves
+    here_smooth[0] = True
+    g._keep_turn_branch(m, hand, grip, start, ("z", -np.pi / 2), "hand-over give grip")
+    assert len(sent) == 1 and len(events) == 1
+
+
 def _herb_ctx(backend: str, sequence: str, seed: int = 0):
     """A TrialContext with HERB, built in-process as the runner builds one (tier label Rubiks-1-1)."""
     from benchharness.backends.interface import PhysicsConfig

@@ -138,6 +138,13 @@ class HerbPushGraspConfig(BimanualConfig):
     #: Rubiks-1-20's first 10 moves the cube wandered from (0.900, 0, 1.100) to (0.907, 0, 1.086) m and the
     #: 11th hand-over turn's IK ended 6.9 mm off (PyBullet, seed 0).
     recentre_turn: bool = True
+    #: when no giver grip solved from the arm's joints has a smooth hand-over turn: starts per finger
+    #: placement, drawn over the whole joint range, from which the turn and the giver's retreat are solved
+    #: backwards (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`, the PR2's value). The IK
+    #: from the arm's joints finds only the branch it is on (SAPIEN Rubiks-1-20 seed 0, the hand-over after
+    #: move 17: both placements' turns stepped 3.3-3.7 rad, the fallback's turn moved the cube and the take
+    #: met no face). 0: the least bad grip instead.
+    giver_backward_seeds: int = 8
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
     #: the picker and a hand-over's taker grip two slabs deep whichever hand rotates next (the machine's rule,

@@ -82,6 +82,8 @@ class BarrettState:
     thumb_lateral: float = (
         0.0  #: where across the palm (tool y, m) the thumb's tip touches, measured
     )
+    #: a giver's grip: the IK solution its hand-over turn was checked from (None: not checked)
+    turn_q: np.ndarray | None = None
 
 
 def _st(hand: Hand) -> BarrettState:
@@ -155,9 +157,14 @@ class PushGrasp:
         ``req.turn``: this hand will give the cube in a hand-over, so the grip should let the arm
         carry that turn and the retreat after it without an IK flip
         (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_travel`); if no grip does, one whose
-        turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not).
+        turn alone is smooth (on HERB the 12 cm retreat straight out of a turned grip often is not);
+        if none, one from an arm posture found backwards (:meth:`_backward_give`); else the least bad.
         Returns the IK solution to reach the grip by when the wrist had to be re-seeded for the twist
-        (see below), else None: the arm moves to the stand-off from where it is.
+        (see below) or for a giver's posture found backwards (:meth:`_backward_give`), else None: the
+        arm moves to the stand-off from where it is. (A giver's turn is checked from the IK solution
+        seeded with the arm's joints now, but the arm reaches the grip from where its swing ends and
+        can arrive on another branch: PyBullet Rubiks-5-5 seed 0 trial 5, docs/herb_push_grasp.md.
+        Sending every giver on its checked solution fixed that trial but cost three others.)
         """
         cfg = self.config
         st = _st(hand)
@@ -186,6 +193,11 @@ class PushGrasp:
             best_score = second_score = fallback_score = -np.inf
             best_slide = second_slide = fallback_slide = 0.0
             best_q: np.ndarray | None = None  # the IK solution to reach ``best`` by, if re-seeded
+            # a giver's: the IK solution the turn of ``best`` / ``second`` was checked from
+            best_turn_q: np.ndarray | None = None
+            second_turn_q: np.ndarray | None = None
+            # a giver's placements that pass the other rules: (pose, score without the arm's posture, slide)
+            give_places: list[tuple[Pose, float, float]] = []
             # diagnostic for the recorder: each candidate and why it was taken or not
             tried: list[str] = []
             lateral = cfg.holder_thumb_offset if st.shape == 2 else cfg.rotator_thumb_offset
@@ -265,6 +277,9 @@ class PushGrasp:
                         score -= 1.0
                     if score > fallback_score:
                         fallback, fallback_score, fallback_slide = pose, score, shift - lateral
+                    give_places.append(
+                        (pose, score + 0.1 * joint_move - min(margin, 0.3), shift - lateral)
+                    )
                     travel, worst = m.turn_travel(hand, base, [pose], res.q[:1], *turn)
                     if not np.isfinite(travel[0]):
                         # the turn, or the giver's retreat after it, leaves the arm's branch; a grip whose
@@ -281,6 +296,7 @@ class PushGrasp:
                             second = pose
                             second_score = score - 0.1 * float(short[0])
                             second_slide = shift - lateral
+                            second_turn_q = np.asarray(res.q[0], dtype=float)
                         continue
                     score -= 0.1 * float(travel[0])
                 tried.append(
@@ -289,14 +305,20 @@ class PushGrasp:
                 if score > best_score:
                     best, best_score, best_slide = pose, score, shift - lateral
                     best_q = q_seeded
+                    best_turn_q = None if turn is None else np.asarray(res.q[0], dtype=float)
             if reseed or not req.twist_now or best is None or best_score > -5.0:
                 break
+        if best is None and second is None and turn is not None and give_places:
+            found = self._backward_give(m, hand, base, q_now, give_places, turn)
+            if found is not None:
+                best, best_slide, best_q = found
+                tried.append("a posture found backwards from the retreat's end (giver_posture)")
         if best is None and second is not None:
             m.ctx.recorder.event(
                 "warning",
                 message=f"{hand.side}: no grip lets the giver retreat straight after the hand-over turn",
             )
-            best, best_slide = second, second_slide
+            best, best_slide, best_turn_q = second, second_slide, second_turn_q
         if best is None and fallback is not None:
             m.ctx.recorder.event(
                 "warning", message=f"{hand.side}: no grip lets the hand-over turn run smoothly"
@@ -316,7 +338,61 @@ class PushGrasp:
                 "unreachable", f"{hand.side} arm: no push-grasp from {world_dir} reachable"
             )
         st.slide = best_slide
+        st.turn_q = best_turn_q if best_q is None else None
         return best, best_q
+
+    def _backward_give(
+        self,
+        m: BimanualRubiksMachine,
+        hand: Hand,
+        base: Pose,
+        q_now: np.ndarray,
+        places: list[tuple[Pose, float, float]],
+        turn: tuple[str, float],
+    ) -> tuple[Pose, float, np.ndarray] | None:
+        """A giver's grip whose hand-over turn (and the retreat after it) runs smoothly from an arm
+        posture found backwards from the retreat's end, when no grip solved from the arm's joints has
+        even a smooth turn (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`,
+        ``giver_backward_seeds`` starts per placement; the PR2's giver does the same). Each chain found
+        is checked forwards again (``turn_travel``) and scored as :meth:`choose` scores a giver's grip
+        (the placement's preferences, the joint change from where the arm is, the turn's travel).
+        Returns (grip, its slide, the posture's IK solution: the arm is sent on it) or None; recorded
+        as a ``giver_posture`` event.
+
+        Why: seeded from where the arm is, IK finds only the branch it is on; measured (SAPIEN
+        Rubiks-1-20 seed 0, the hand-over after move 17, right giver, -90 deg about z): both
+        placements' turns stepped 3.3-3.7 rad, the fallback grip's turn moved the cube and the take's
+        push met no face.
+        """
+        n = self.config.giver_backward_seeds
+        if n <= 0:
+            return None
+        owner, qs = m.turn_postures(hand, base, [p for p, _, _ in places], *turn, n_seeds=n)
+        if not owner:
+            m.ctx.recorder.event("giver_posture", hand=hand.side, chains=0)
+            return None
+        grips = [places[i][0] for i in owner]
+        travel, _ = m.turn_travel(hand, base, grips, qs, *turn)
+        change = np.max(np.abs(qs - q_now), axis=1)
+        score = np.array([places[i][1] for i in owner]) - 0.1 * change - 0.1 * travel
+        m.ctx.recorder.event(
+            "giver_posture",
+            hand=hand.side,
+            chains=len(owner),
+            checked=int(np.isfinite(travel).sum()),
+            **(
+                {}
+                if not np.isfinite(score).any()
+                else {
+                    "joint_change": round(float(change[int(np.argmax(score))]), 2),
+                    "travel": round(float(travel[int(np.argmax(score))]), 2),
+                }
+            ),
+        )
+        if not np.isfinite(score).any():
+            return None
+        j = int(np.argmax(score))
+        return grips[j], places[owner[j]][2], np.asarray(qs[j], dtype=float)
 
     def _clear_lateral(
         self, m: BimanualRubiksMachine, hand: Hand, face_pose: Pose, nominal: float
@@ -381,6 +457,8 @@ class PushGrasp:
         cfg, rec, label = self.config, m.ctx.recorder, req.label
         z = approach_axis(grip)
         start = Pose(grip.p - cfg.push_start * z, grip.q)
+        if req.turn is not None and _st(hand).turn_q is not None:
+            self._keep_turn_branch(m, hand, grip, start, req.turn, label)
         m.send(hand, start, label=f"{label} push start", settle=0.1)
         noise = m.noise()
         try:
@@ -437,6 +515,57 @@ class PushGrasp:
             )
         if cfg.centre_tolerance is not None and m.other(hand).holding:
             self._centre_pinch(m, hand, label)
+
+    def _keep_turn_branch(
+        self,
+        m: BimanualRubiksMachine,
+        hand: Hand,
+        grip: Pose,
+        start: Pose,
+        turn: tuple[str, float],
+        label: str,
+    ) -> None:
+        """At a giver's stand-off: if the grip the arm would push to from here (IK chained from its
+        joints through the push's start) cannot carry the hand-over turn smoothly while the solution
+        :meth:`choose` checked it from can, change to that branch here, at the stand-off, before moving
+        in (a ``give_branch`` event). Otherwise nothing moves.
+
+        Why: the turn is checked from the grip's IK solution seeded with the arm's joints at choice time,
+        but the arm reaches the stand-off from where its swing ends, and IK there can pick another
+        branch. Measured (PyBullet Rubiks-5-5 seed 0 trial 5, first hand-over, right giver one slab
+        deep, -90 deg about z): checked from q7 = 2.15 rad, every step <= 0.57 rad; the arm arrived at
+        q7 = -3.00 on its limit, the turn's 3rd waypoint moved q1/q5/q6/q7 by 1.2/2.6/2.5/4.6 rad and
+        the cube fell. (Sending every giver on its checked solution fixed that trial but changed the
+        others' postures, and three of the five then failed downstream.)
+        """
+        st = _st(hand)
+        assert st.turn_q is not None
+        base = hand.arm.base_pose()
+        q = hand.arm.positions()
+        res = hand.arm.ik((base.inv() * start).as_matrix()[None], seed_q=q)
+        if not res.success[0]:
+            return
+        res = hand.arm.ik((base.inv() * grip).as_matrix()[None], seed_q=res.q[0])
+        if not res.success[0]:
+            return
+        here, worst = m.turn_travel(hand, base, [grip], res.q[:1], *turn, with_retreat=False)
+        if np.isfinite(here[0]):
+            return
+        checked, _ = m.turn_travel(hand, base, [grip], st.turn_q[None], *turn, with_retreat=False)
+        if not np.isfinite(checked[0]):
+            return
+        far = hand.arm.ik((base.inv() * hand.cmd).as_matrix()[None], seed_q=st.turn_q)
+        if not far.success[0]:
+            return
+        q_far = np.asarray(far.q[0], dtype=float)
+        m.ctx.recorder.event(
+            "give_branch",
+            hand=hand.side,
+            label=label,
+            largest_step_here=round(float(worst[0]), 2),
+            joint_change=round(float(np.max(np.abs(q_far - q))), 2),
+        )
+        m.send(hand, hand.cmd, label=f"{label} give branch", settle=0.1, seed_q=q_far)
 
     def _pinch_sides(
         self, m: BimanualRubiksMachine, hand: Hand
