@@ -257,8 +257,14 @@ def test_giver_changes_to_the_checked_branch_only_when_its_turn_would_not_be_smo
     sent, events, here_smooth = [], [], [False]
     hand = SimpleNamespace(side="right", arm=Arm(), cmd=Pose([0.0, 0.0, 0.1]), state=BarrettState())
     hand.state.turn_q = checked
+
+    def ik_q(h, pose, seed):  # the machine's: the arm's IK, None if it fails
+        res = h.arm.ik(None, seed_q=seed)
+        return np.asarray(res.q[0], dtype=float) if res.success[0] else None
+
     m = SimpleNamespace(
         turn_travel=turn_travel,
+        ik_q=ik_q,
         send=lambda h, target, **kw: sent.append((target, kw)),
         ctx=SimpleNamespace(
             recorder=SimpleNamespace(event=lambda kind, **kw: events.append((kind, kw)))

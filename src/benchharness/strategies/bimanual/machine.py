@@ -789,8 +789,9 @@ class BimanualRubiksMachine:
             )
         self.transit(hand, far, label=label, seed_q=seed_q)
 
-    def _ik_q(self, hand: Hand, pose: Pose, seed: np.ndarray) -> np.ndarray | None:
-        """The arm's IK solution for the (believed) tool pose ``pose`` from ``seed``; None if unreachable."""
+    def ik_q(self, hand: Hand, pose: Pose, seed: np.ndarray) -> np.ndarray | None:
+        """The arm's IK solution for the (believed) tool pose ``pose`` from ``seed``; None if unreachable.
+        (Public: grasp modules chain their own solves with it.)"""
         base = hand.arm.base_pose()
         res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
         return np.asarray(res.q[0], dtype=float) if bool(res.success[0]) else None
@@ -849,7 +850,7 @@ class BimanualRubiksMachine:
         out = []
         for i in range(1, n + 1):
             way = Pose(a.p + (b.p - a.p) * i / n, b.q)
-            q1 = self._ik_q(hand, way, q)
+            q1 = self.ik_q(hand, way, q)
             if q1 is None or not self._clears(hand, q, q1, points):
                 return None
             out.append((way, q1))
@@ -890,7 +891,7 @@ class BimanualRubiksMachine:
             return
         q0 = hand.arm.positions()
         plan_seed = q0 if seed_q is None else seed_q
-        q1 = self._ik_q(hand, target, plan_seed)
+        q1 = self.ik_q(hand, target, plan_seed)
         if q1 is None or (not detour and self._clears(hand, q0, q1, points)):
             self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
             return
@@ -909,7 +910,7 @@ class BimanualRubiksMachine:
                 # SAPIEN Rubiks-1-20 sensor-aided seed 0)
                 leg_out = []
             qa = leg_out[-1][1] if leg_out else q0
-            qb = self._ik_q(hand, turned, plan_seed)
+            qb = self.ik_q(hand, turned, plan_seed)
             if qb is None or not self._clears(hand, qa, qb, points):
                 continue
             leg_in = self._line(hand, turned, target, qb, points)
@@ -1200,7 +1201,7 @@ class BimanualRubiksMachine:
         (``stop_on_fail``: stop at the first that fails, else give up)."""
         out: list[tuple[Pose, np.ndarray, str]] = []
         for way in poses:
-            q1 = self._ik_q(hand, way, q)
+            q1 = self.ik_q(hand, way, q)
             if (
                 q1 is None
                 or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump

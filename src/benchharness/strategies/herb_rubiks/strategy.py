@@ -542,22 +542,19 @@ class PushGrasp:
         assert st.turn_q is not None
         base = hand.arm.base_pose()
         q = hand.arm.positions()
-        res = hand.arm.ik((base.inv() * start).as_matrix()[None], seed_q=q)
-        if not res.success[0]:
+        q_start = m.ik_q(hand, start, q)
+        q_grip = None if q_start is None else m.ik_q(hand, grip, q_start)
+        if q_grip is None:
             return
-        res = hand.arm.ik((base.inv() * grip).as_matrix()[None], seed_q=res.q[0])
-        if not res.success[0]:
-            return
-        here, worst = m.turn_travel(hand, base, [grip], res.q[:1], *turn, with_retreat=False)
+        here, worst = m.turn_travel(hand, base, [grip], q_grip[None], *turn, with_retreat=False)
         if np.isfinite(here[0]):
             return
         checked, _ = m.turn_travel(hand, base, [grip], st.turn_q[None], *turn, with_retreat=False)
         if not np.isfinite(checked[0]):
             return
-        far = hand.arm.ik((base.inv() * hand.cmd).as_matrix()[None], seed_q=st.turn_q)
-        if not far.success[0]:
+        q_far = m.ik_q(hand, hand.cmd, st.turn_q)
+        if q_far is None:
             return
-        q_far = np.asarray(far.q[0], dtype=float)
         m.ctx.recorder.event(
             "give_branch",
             hand=hand.side,
