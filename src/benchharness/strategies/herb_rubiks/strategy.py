@@ -375,6 +375,7 @@ class PushGrasp:
         travel, _ = m.turn_travel(hand, base, grips, qs, *turn)
         change = np.max(np.abs(qs - q_now), axis=1)
         score = np.array([places[i][1] for i in owner]) - 0.1 * change - 0.1 * travel
+        j = int(np.argmax(score)) if np.isfinite(score).any() else None
         m.ctx.recorder.event(
             "giver_posture",
             hand=hand.side,
@@ -382,16 +383,15 @@ class PushGrasp:
             checked=int(np.isfinite(travel).sum()),
             **(
                 {}
-                if not np.isfinite(score).any()
+                if j is None
                 else {
-                    "joint_change": round(float(change[int(np.argmax(score))]), 2),
-                    "travel": round(float(travel[int(np.argmax(score))]), 2),
+                    "joint_change": round(float(change[j]), 2),
+                    "travel": round(float(travel[j]), 2),
                 }
             ),
         )
-        if not np.isfinite(score).any():
+        if j is None:
             return None
-        j = int(np.argmax(score))
         return grips[j], places[owner[j]][2], np.asarray(qs[j], dtype=float)
 
     def _clear_lateral(
