@@ -3,7 +3,7 @@
 Its ``...`` (the robot's actions) does nothing, so no layer turns: every twist
 the example opens must still end aligned (the cube's own step callback holds
 the detents while the robot settles), the cube must end rigid and solved, and
-no step callback may outlive the twists.
+none of the cube's step callbacks may outlive the twists.
 """
 
 from __future__ import annotations
@@ -53,6 +53,11 @@ def test_the_runner_doc_strategy_example_runs():
         moves = [e for e in ctx.recorder.events if e["kind"] == "move"]
         assert [(e["move"], e["moves"]) for e in moves] == [("U", ""), ("R'", "")]
         assert len(ctx.recorder.estimates) == 2
-        assert not be._step_callbacks  # the cube went rigid: its callback is gone
+        # the cube went rigid: its callback is gone (the robot's grippers keep theirs while a finger
+        # still moves faster than 1e-4 rad/s, which settling may or may not have reached by now)
+        owners = {
+            type(getattr(cb, "__self__", None)).__module__ for cb in be._step_callbacks.values()
+        }
+        assert not {o for o in owners if o.startswith("benchharness.cube_physics")}, owners
     finally:
         be.close()

@@ -129,7 +129,11 @@ def stable_rest_poses(
 
     From trimesh's quasi-static stable poses of the convex hull about the
     centre of mass; each is turned about the vertical so that the grasp axis
-    lies along world +y, and centred at x = y = 0. Order: most probable first.
+    lies along world +y, and centred at x = y = 0. Order: most probable first;
+    equal probabilities (a box's opposite faces: trimesh gives them equal to
+    ~1e-15, and which comes first then depends on the CPU and library
+    release) by the smaller turn from the object's own frame, then by the
+    canonical quaternion, so that the derived tasks are the same everywhere.
     """
     hull = mesh.convex_hull
     transforms, probs = _stable_poses(hull, np.asarray(com, float))
@@ -146,7 +150,13 @@ def stable_rest_poses(
         v = rot.apply(np.asarray(hull.vertices))
         p = np.array([0.0, 0.0, -float(v[:, 2].min()) + 5e-4])
         out.append((float(pr), Pose.from_rotation(p, rot)))
-    out.sort(key=lambda t: -t[0])
+    out.sort(
+        key=lambda t: (
+            -round(t[0], 9),
+            round(float(t[1].rotation.magnitude()), 9),
+            tuple(np.round(t[1].rotation.as_quat(canonical=True), 9)),
+        )
+    )
     return [p for _, p in out]
 
 
