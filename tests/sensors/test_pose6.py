@@ -28,6 +28,7 @@ from benchharness.sensors import (
     ray_box,
 )
 from benchharness.sensors.pose6 import compose, edge_model, left_jacobian, range_model
+from benchharness.sensors.sweep import EdgeObservation
 
 HALF = 0.0285
 PRIOR_STD = np.array([0.006, 0.006, 0.006, *np.radians([2.0, 2.0, 3.0])])
@@ -170,3 +171,70 @@ def test_a_masked_reading_is_neither_face_nor_beyond_an_edge():
     z3[10:13] = 0.06  # the robot's own finger 30 mm behind the face: still beyond the edge
     (e,) = find_edges(o, d, z3, exclude=excl)
     assert not e.entering and abs(e.point[0] - 0.0095) < 1e-9
+
+
+#: Recorded in PyBullet Rubiks-1-100, sensor-aided, seed 0 (the right hand's "shift out" sweeps before
+#: move 87, at 8a73476): the true and believed cube, and the two edges the up/down sweeps found on the
+#: face the beam ranged (-y face, beam along +y). Both are the top edge. The first is a plain exit; the
+#: second is an entry whose step (the emitter's motion between its two readings) is mostly along world
+#: x, because the arm was still moving from the previous sweep's end. Associated by its step with a side
+#: edge it moved the belief 17 mm along x and the next grip jammed.
+_TRUE_SHIFT_OUT = Pose(
+    np.array([0.597965021286057, -0.0022973097940557187, 0.6027575698672842]),
+    np.array([0.475057916865649, 0.5154523461049252, -0.5123371412822425, -0.49612448859226654]),
+)
+_BELIEF_SHIFT_OUT = Pose(
+    np.array([0.5957645249916173, 0.00010719889680592767, 0.6020042127994657]),
+    np.array([-0.4800263740368852, -0.5149762732688824, 0.5076744416266072, 0.49662941869990584]),
+)
+_EDGES_SHIFT_OUT = [
+    EdgeObservation(
+        point=np.array([0.6092764222962589, -0.0339168018419095, 0.6310797237197376]),
+        step=np.array([0.009462282447160013, -0.05516836952507898, 0.9984322291547056]),
+        direction=np.array([-0.048211129053205695, 0.9986330371327363, 0.020192676456131837]),
+        entering=False,
+        std_along=0.0007160853922582927,
+        std_range=0.0010115423678776173,
+        index=15,
+    ),
+    EdgeObservation(
+        point=np.array([0.586953961354957, -0.03348691906954742, 0.630355678148118]),
+        step=np.array([0.7888562957859224, -0.42451799248580485, -0.44439871585630775]),
+        direction=np.array([-0.03829166388537142, 0.9989914533661222, 0.02344833849833806]),
+        entering=True,
+        std_along=0.0005551841233086639,
+        std_range=0.0010171151866617365,
+        index=8,
+    ),
+]
+
+
+def test_an_edge_is_the_border_it_lies_on_not_the_one_its_step_points_at():
+    """Both recorded edges lie 28-29 mm above the believed centre, 9-14 mm off it sideways: the top
+    border. The exit is associated with it and agrees with the truth within its noise; the entry, whose
+    step crosses the top border at under 0.5, is not associated at all (never with a side border)."""
+    for pose in (_TRUE_SHIFT_OUT, _BELIEF_SHIFT_OUT):
+        exit_, entry = (edge_model(pose, HALF, e) for e in _EDGES_SHIFT_OUT)
+        assert entry is None
+        assert exit_ is not None
+        h, jac, var = exit_
+        up = pose.rotation.as_matrix()[:, int(np.argmax(np.abs(pose.rotation.as_matrix()[2])))]
+        assert (
+            abs(abs(float(jac[:3] @ up)) - 1.0) < 1e-12
+        )  # d h / d centre = -m, m the top face's normal
+    h, _, var = edge_model(_TRUE_SHIFT_OUT, HALF, _EDGES_SHIFT_OUT[0])
+    assert abs(h) < 2 * np.sqrt(var)
+
+
+def test_the_recorded_shift_out_edges_do_not_move_the_belief_sideways():
+    """The prior the PR2's sweeps use (6 mm, 2/2/3 degrees); the edges alone (its rays aside) observe
+    the top face's height only, so the belief along world x must stay within 1 mm of where it was
+    (it moved 17.4 mm with the entry taken for a side edge)."""
+    kf = CubePose6Filter(PoseEstimate(_BELIEF_SHIFT_OUT, np.diag(PRIOR_STD**2), axes=POSE6_AXES))
+    rep = kf.update(edges=_EDGES_SHIFT_OUT)
+    assert rep.n_edges_used == 1 and rep.n_edges_unassociated == 1
+    assert abs(kf.pose.p[0] - _BELIEF_SHIFT_OUT.p[0]) < 0.001
+    # and the height moves towards the truth
+    assert abs(kf.pose.p[2] - _TRUE_SHIFT_OUT.p[2]) < abs(
+        _BELIEF_SHIFT_OUT.p[2] - _TRUE_SHIFT_OUT.p[2]
+    )

@@ -21,9 +21,10 @@ is handled alike (the box's symmetry only matters if the belief is 45° off).
   ``∂h/∂δp = −m`` and ``∂h/∂δθ = m × (q − c)``; its variance is
   ``(m·u)² σ_along² + (m·d)² σ_range²`` (``u`` the sweep direction). An edge
   fixes the cube across the beam; two points on one edge fix the rotation
-  about the face normal. ``m`` is chosen on the estimated box: the face
-  other than the ranged one whose normal is most nearly along the sweep,
-  pointing the way the beam left the face (or against the way it came on).
+  about the face normal. ``m`` is chosen on the estimated box: the border of
+  the ranged face nearest the transition point (:func:`edge_model`), used
+  only when the beam crossed it the right way (out when leaving, in when
+  entering) by at least half its motion.
 
 The rotation columns above are for a small turn on the left of the current
 estimate; the filter multiplies them by the SO(3) left Jacobian of ``δθ``
@@ -114,20 +115,31 @@ def edge_model(
 ) -> tuple[float, np.ndarray, float] | None:
     """``h(x)`` (m), its Jacobian (6,) and its variance (m²) for one edge at the box ``pose``.
 
-    None when the edge cannot be associated: the sweep runs nearly along the
-    candidate face (|m·u| < 0.5), so the transition says little across it.
+    The edge is the ranged face's border nearest the transition point on the
+    box at ``pose`` (the point lies on the face, within a few mm of the edge it
+    crossed; the two other borders it could be taken for are a face-width
+    away), with ``m`` the adjacent face's outward normal there. Not the border
+    the step points at: the step is the emitter's motion between two readings,
+    and at a sweep's start the arm may still be moving from the previous
+    sweep's end (measured, PyBullet Rubiks-1-100 sensor-aided: a down-sweep's
+    step 0.79 along the face's horizontal axis as its beam came onto the top
+    edge; taken for a side edge it moved the belief 17 mm sideways and the
+    next grip jammed).
+
+    None when the edge cannot be associated: the step crosses that border
+    the wrong way for an entry or exit, or nearly along it (the motion across
+    it, ``|m·u|``, under 0.5), so the transition says little across it.
     """
     rot = pose.rotation.as_matrix()
     d = edge.direction
     u = edge.step
+    v = edge.point - pose.p
     k_face = int(np.argmax(np.abs(rot.T @ d)))  # the face the beam ranged
     others = [j for j in range(3) if j != k_face]
-    j = max(others, key=lambda i: abs(float(rot[:, i] @ u)))
-    mu = float(rot[:, j] @ u)
-    if abs(mu) < 0.5:
+    j = max(others, key=lambda i: abs(float(rot[:, i] @ v)))
+    m = rot[:, j] * float(np.sign(rot[:, j] @ v))  # outward, across the nearest border
+    if float(m @ u) * (-1.0 if edge.entering else 1.0) < 0.5:
         return None
-    m = rot[:, j] * (np.sign(mu) * (-1.0 if edge.entering else 1.0))
-    v = edge.point - pose.p
     h = float(m @ v) - half
     jac = np.concatenate([-m, np.cross(m, v)])
     var = float(m @ u) ** 2 * edge.std_along**2 + float(m @ d) ** 2 * edge.std_range**2
