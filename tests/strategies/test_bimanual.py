@@ -160,13 +160,16 @@ class _Rec:
         self.events.append((kind, data))
 
 
-def _swing_setup(reachable):
+def _swing_setup(reachable, **cfg):
+    from dataclasses import replace
     from types import SimpleNamespace
 
     from benchharness.geometry import Pose
     from benchharness.strategies.bimanual.machine import Hand
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
 
-    m = _herb_machine()
+    m = PushGraspStrategy(replace(HerbPushGraspConfig(), **cfg))
     c = np.array([0.9, 0.0, 1.1])
     m.est = Pose(c)
     m.ctx = SimpleNamespace(recorder=_Rec())
@@ -179,8 +182,13 @@ def _swing_setup(reachable):
 
 def test_checked_swing_takes_the_first_route_the_arm_can_follow():
     """``swing_routes``: the direct arc is refused when a waypoint is out of reach, and a two-leg route
-    over the top is taken whole (recorded as a ``swing`` event); none passes: a warning and no waypoints."""
-    m, hand, far, u0, u1, c = _swing_setup(lambda p: p[2] > c[2] + 0.03 or abs(p[2] - c[2]) < 1e-9)
+    over the top is taken whole (recorded as a ``swing`` event); none passes: a warning and no waypoints.
+    No margin for the injected errors here (the reachable set is a plane and a half-space): the next test
+    has it."""
+    nm = {"swing_reach_sigmas": None}
+    m, hand, far, u0, u1, c = _swing_setup(
+        lambda p: p[2] > c[2] + 0.03 or abs(p[2] - c[2]) < 1e-9, **nm
+    )
     # the ends are level with the cube (reachable), the direct arc's waypoints too: it is taken
     route = m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15)
     assert route and all(abs(w.p[2] - c[2]) < 1e-9 for w in route)
@@ -194,16 +202,56 @@ def test_checked_swing_takes_the_first_route_the_arm_can_follow():
             p[2] > c[2] + 0.03
             or np.linalg.norm(p - (c + [-0.15, 0, 0])) < 1e-9
             or np.linalg.norm(p - (c + [0, 0.15, 0])) < 1e-9
-        )
+        ),
+        **nm,
     )
     route = m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15)
     assert route and all(w.p[2] > c[2] + 0.03 for w in route)
     kind, data = m.ctx.recorder.events[-1]
     assert kind == "swing" and data["legs"] == 2
     # nothing between the ends is reachable: no route, a warning
-    m, hand, far, u0, u1, c = _swing_setup(lambda p: False)
+    m, hand, far, u0, u1, c = _swing_setup(lambda p: False, **nm)
     assert m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15) == []
     assert m.ctx.recorder.events[-1][0] == "warning"
+
+
+def test_checked_swing_passes_over_a_route_whose_waypoint_leaves_the_reach_with_the_errors():
+    """``swing_reach_sigmas`` (HERB: 3): the arm reaches only down to 1 mm below the cube's centre. The
+    direct arc (level with the centre) and the four level arcs through the middle have an IK solution at
+    every waypoint but not 3 sigma of the injected position error lower, so the route over the top is
+    taken, every waypoint of which (checked here from the geometry, not the machine) keeps the whole
+    margin box in reach. Without a margin the level direct arc is taken, as before; with nothing above
+    reachable either, the first level arc is taken with a warning and ``margin=False``."""
+    floor = 0.001
+    m, hand, far, u0, u1, c = _swing_setup(lambda p: p[2] >= c[2] - floor)
+    err = m.config.errors
+    assert m.config.swing_reach_sigmas == 3.0 and m.config.reach_sigmas is None
+    dp = 3.0 * np.hypot(err.calib_pos_std, err.tracking_std)  # 5.4 mm
+
+    def box_in_reach(p):
+        return all(p[2] + s * dp * a[2] >= c[2] - floor for a in np.eye(3) for s in (1, -1))
+
+    route = m._swing_route(hand, far, "t", u0, u1, 0.15, 0.15)
+    assert route and all(box_in_reach(w.p) for w in route)
+    assert min(w.p[2] for w in route) > c[2] + 0.04  # over the top: 18 deg steps of a 15 cm arc
+    kind, data = m.ctx.recorder.events[-1]
+    assert kind == "swing" and data["legs"] == 2 and data["margin_skipped"] == 5
+    # no margin (the old check): the direct arc, whose waypoints the errors can put out of reach
+    m0, hand0, far0, *_ = _swing_setup(lambda p: p[2] >= c[2] - floor, swing_reach_sigmas=None)
+    old = m0._swing_route(hand0, far0, "t", u0, u1, 0.15, 0.15)
+    assert old and all(abs(w.p[2] - c[2]) < 1e-9 for w in old)
+    assert not any(box_in_reach(w.p) for w in old)
+    assert m0.ctx.recorder.events[-1] == (
+        "swing",
+        {"hand": "left", "label": "t", "legs": 1, "waypoints": len(old)},
+    )
+    # only the level band reachable: no route keeps the margin, the first on the branch is taken
+    m1, hand1, far1, *_ = _swing_setup(lambda p: abs(p[2] - c[2]) <= floor)
+    got = m1._swing_route(hand1, far1, "t", u0, u1, 0.15, 0.15)
+    assert [w.p.tolist() for w in got] == [w.p.tolist() for w in old]
+    (k1, warn), (k2, swing) = m1.ctx.recorder.events[-2:]
+    assert k1 == "warning" and "margin" in warn["message"]
+    assert k2 == "swing" and swing["legs"] == 1 and swing["margin"] is False
 
 
 def test_swing_routes_and_giver_depth_are_herb_options_the_pr2_leaves_off():

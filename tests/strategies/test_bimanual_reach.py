@@ -279,3 +279,127 @@ def test_handover_turn_brings_a_tilted_believed_cube_back_to_faces_level():
         for i in range(5):
             got, want = path.at(grip, i, 4), old(grip, est, "z", math.pi / 2, i, 4)
             assert np.array_equal(got.p, want.p) and np.array_equal(got.q, want.q)
+
+
+#: the inputs of one checked swing, recorded (PyBullet Rubiks-5-5 seed 0 trial 3, t = 244.47 s, at 152efdd:
+#: the right hand's hand-over re-grip): the arm's joints, its commanded tool pose, the stand-off, the
+#: believed cube, the arm's base (world) and the trial's injected calibration of that arm (SAPIEN's trial 3
+#: draws the same one), poses as (position, quaternion x y z w)
+_SWING_244 = {
+    "q": [
+        -0.6003719538755002,
+        -1.476589878755763,
+        0.4445584287956909,
+        2.8763725650208563,
+        0.5073098221183098,
+        -1.4341462978004618,
+        2.074535486213225,
+    ],
+    "cmd": (
+        [0.7181065893332236, 0.008234905864029491, 1.0957784402133681],
+        [-0.6984415545011888, 0.02428777439329527, -0.7152155550426016, -0.007497251902313817],
+    ),
+    "far": (
+        [0.891069105396176, -0.19975492826495925, 1.0951458343885732],
+        [-0.007505512877098108, -0.6984332935264046, -0.7152238160173858, -0.024279513418510867],
+    ),
+    "est": (
+        [0.8998833869490701, -0.002608252885807271, 1.0999366178768446],
+        [0.7152155550426016, -0.00749725190231386, -0.6984415545011888, -0.024287774393295155],
+    ),
+    "base": (
+        [0.0053783804178237915, -0.05080476403236389, 0.6925790309906006],
+        [0.7070903591565018, 3.275723255323458e-05, 0.7071232013176751, -3.2758749590485e-05],
+    ),
+    "cal": (
+        [-7.035385397987487e-05, -0.0012593669548052943, -0.003587919833316346],
+        [0.0010451919671103066, -0.006095278010839253, -0.0015747407602490786, 0.999979637468314],
+    ),
+}
+
+
+def test_swing_route_keeps_the_errors_margin_on_herbs_own_kinematics():
+    """A recorded HERB re-grip swing replayed on the WAM's own IK (no engine). Without the margin the
+    route check takes a two-leg route whose first waypoint, in front of the cube near the torso, the arm
+    reaches for the believed pose; sent with the trial's calibration (no tracking draw) it is out of
+    reach: the IK's best is, by forward kinematics, more than ``ik_slack`` (5 mm) and 1.4 deg from it, the
+    figures of SAPIEN Rubiks-5-5 trial 3's `unreachable` at ffe4661 (docs/herb_push_grasp.md, "Arc
+    waypoints and the injected errors"). With HERB's ``swing_reach_sigmas`` that route is passed over,
+    and every waypoint of the route taken, sent with the same calibration, and every neighbour in its
+    3-sigma box are reached: forward kinematics of the chained IK solutions lands on each target."""
+    from dataclasses import replace
+
+    from benchharness.plugin.manager import get_manager
+    from benchharness.robots.kinematics import pose_error
+    from benchharness.strategies.bimanual.machine import Hand
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    d = _SWING_244
+    base = Pose(*d["base"])
+    q0 = np.array(d["q"])
+    arm = get_manager().create("robot", "herb").arm("right_arm")
+
+    class Arm:  # the real arm's kinematics, its base where it was (no engine)
+        lower, upper = arm.lower, arm.upper
+
+        def base_pose(self):
+            return base
+
+        def positions(self):
+            return q0
+
+        def ik(self, mats, seed_q=None):
+            return arm.ik(mats, seed_q=seed_q)
+
+    def route(**cfg):
+        m = PushGraspStrategy(replace(HerbPushGraspConfig(), **cfg))
+        m.est = Pose(*d["est"])
+        m.ctx = SimpleNamespace(recorder=_Rec())
+        hand = Hand("right", Arm(), None, Pose(*d["cal"]), Pose(*d["cmd"]))
+        far = Pose(*d["far"])
+        c = m.est.p
+        r0, r1 = np.linalg.norm(hand.cmd.p - c), np.linalg.norm(far.p - c)
+        u0, u1 = (hand.cmd.p - c) / r0, (far.p - c) / r1
+        poses = m._swing_route(hand, far, "re-grip stand-off", u0, u1, float(r0), float(r1))
+        return m, hand, poses
+
+    def solve(target, seed):
+        """IK from ``seed``, then FK of its answer: (solution, mm, deg off the target)."""
+        res = arm.ik((base.inv() * target).as_matrix()[None], seed_q=seed)
+        got = base * Pose.from_matrix(arm.fk(res.q[:1])[0])
+        dp, dr = pose_error(got.as_matrix()[None], target.as_matrix()[None])
+        return res.q[0], 1000 * float(dp[0]), math.degrees(float(dr[0]))
+
+    m0, hand0, old = route(swing_reach_sigmas=None)
+    assert m0.ctx.recorder.events[-1][1]["legs"] == 2 and len(old) == 5
+    assert old[0].p == pytest.approx([0.719, -0.040, 1.095], abs=1e-3)
+    _, mm_b, deg_b = solve(old[0], q0)
+    assert mm_b < 0.01 and deg_b < 0.01  # the believed waypoint: reached
+    _, mm_s, deg_s = solve(m0.actual(hand0, old[0], np.zeros(3)), q0)
+    assert mm_s > 1000 * m0.config.ik_slack and deg_s > 1.4  # as sent: out of reach
+
+    m1, hand1, new = route()
+    assert m1.config.swing_reach_sigmas == 3.0
+    kind, data = m1.ctx.recorder.events[-1]
+    assert kind == "swing" and data["margin_skipped"] == 1 and "margin" not in data
+    assert all(not w.p == pytest.approx(old[0].p, abs=1e-3) for w in new)
+    err = m1.config.errors
+    dp = 3.0 * np.hypot(err.calib_pos_std, err.tracking_std)
+    dr = 3.0 * math.radians(err.calib_rot_std_deg)
+    q = q0
+    for w in new:
+        q, mm_w, deg_w = solve(w, q)
+        assert mm_w < 0.01 and deg_w < 0.01
+        sent = m1.actual(hand1, w, np.zeros(3))
+        box = [sent] + [
+            Pose(w.p + s * dp * a, w.q)
+            if turn is None
+            else Pose.from_rotation(w.p, Rotation.from_rotvec(s * dr * a) * w.rotation)
+            for a in np.eye(3)
+            for s in (1.0, -1.0)
+            for turn in (None, True)
+        ]
+        for target in box:
+            _, mm_t, deg_t = solve(target, q)
+            assert mm_t < 0.1 and deg_t < 0.05, (w.p, target.p)

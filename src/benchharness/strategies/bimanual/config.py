@@ -96,6 +96,14 @@ class BimanualConfig:
     #: joint stepping more than ``swing_max_joint_step``); none: straight to the stand-off. False: the direct
     #: arc only, a waypoint out of reach left out.
     swing_routes: bool = False
+    #: each waypoint of a checked swing route (``swing_routes``) must stay reachable (IK from its solution on
+    #: the route's chain) with the target moved this many standard deviations of the injected position error
+    #: either way along each world axis and turned as many of the calibration's rotation about each, the box
+    #: ``reach_sigmas`` gives stand-offs and retreat steps (:meth:`.machine.BimanualRubiksMachine.reachable`):
+    #: the arm is sent each waypoint with those errors. A route whose waypoint does not is passed over for the
+    #: next; if every route on the arm's branch fails it, the first is taken (a warning). None: as
+    #: ``reach_sigmas`` (None there too: no margin, a route found for the believed poses is taken).
+    swing_reach_sigmas: float | None = None
     #: largest joint change (rad) between two waypoints of a checked swing route (bigger: IK flipped the arm).
     swing_max_joint_step: float = 1.5
     #: how far the taker backs off along its approach (m) before the giver turns the cube in a hand-over:

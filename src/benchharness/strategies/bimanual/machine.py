@@ -1022,8 +1022,13 @@ class BimanualRubiksMachine:
         or 180 deg about the approach at the via (a hand in front of the cube near the torso
         cannot turn round it directly). A route passes if every waypoint and the stand-off have
         an IK solution, each seeded with the previous one from the arm's joints, no joint moving
-        more than ``swing_max_joint_step`` between two. None passes: a warning, and the hand moves
-        straight to the stand-off (no waypoints). Recorded as a ``swing`` event.
+        more than ``swing_max_joint_step`` between two, and every waypoint is :meth:`reachable` from
+        its solution with ``swing_reach_sigmas`` (default ``reach_sigmas``) of the injected errors:
+        the arm is sent each waypoint with those errors. Recorded as a ``swing`` event
+        (``margin_skipped``: routes on the branch passed over for the margin). If routes are on the
+        branch but none keeps the margin, the first is taken (a warning; the event has
+        ``margin=False``). None passes: a warning, and the hand moves straight to the stand-off (no
+        waypoints).
         """
         cfg = self.config
         c = self.est.p
@@ -1045,11 +1050,17 @@ class BimanualRubiksMachine:
             for roll in (0.0, math.pi / 2, -math.pi / 2, math.pi):
                 rolled = top * Rotation.from_rotvec(along(self.grasp.approach_axis, roll))
                 routes.append(([u0, via, u1], [start.q, rolled.as_quat(), far.q]))
+        sigmas = cfg.reach_sigmas if cfg.swing_reach_sigmas is None else cfg.swing_reach_sigmas
         base = hand.arm.base_pose()
         why = ""
+        # the first route on the arm's branch whose waypoints do not all keep the margin (taken, with a
+        # warning, only if no route does), and how many routes were passed over for the margin
+        unchecked: tuple[list[Pose], int] | None = None
+        short = 0
         for dirs, quats in routes:
             poses = self._arc(c, dirs, quats, r0, r1)
             q, ok = hand.arm.positions(), True
+            solved: list[np.ndarray] = []
             for pose in [*poses, far]:
                 res = hand.arm.ik((base.inv() * pose).as_matrix()[None], seed_q=q)
                 jump = float(np.max(np.abs(res.q[0] - q)))
@@ -1061,11 +1072,57 @@ class BimanualRubiksMachine:
                     ok = False
                     break
                 q = res.q[0]
-            if ok:
+                solved.append(q)
+            if not ok:
+                continue
+            # each waypoint is sent with the injected errors (``send``) and must be reachable with them,
+            # as a stand-off and a retreat step must (``reachable``, from its solution on the route's
+            # chain); the stand-off itself was chosen by :meth:`standoff`. Why (SAPIEN Rubiks-5-5 seed 0
+            # trial 3 at ffe4661 on the development VM, docs/herb_push_grasp.md): a re-grip's arc, found
+            # reachable for the believed poses, had a waypoint the arm missed by 5.1 mm, 1.5 deg with the
+            # errors (HERB's ``ik_slack`` 5 mm), and the trial ended `unreachable`
+            out = next(
+                (
+                    pose
+                    for pose, qi in zip(poses, solved)
+                    if not self.reachable(hand, pose, qi, sigmas)
+                ),
+                None,
+            )
+            if out is None:
                 self.ctx.recorder.event(
-                    "swing", hand=hand.side, label=label, legs=len(dirs) - 1, waypoints=len(poses)
+                    "swing",
+                    hand=hand.side,
+                    label=label,
+                    legs=len(dirs) - 1,
+                    waypoints=len(poses),
+                    **({"margin_skipped": short} if short else {}),
                 )
                 return poses
+            short += 1
+            why += (
+                f" {len(dirs) - 1}-leg arc: waypoint {np.round(out.p, 3).tolist()} out of reach with "
+                f"the injected errors' margin;"
+            )
+            if unchecked is None:
+                unchecked = (poses, len(dirs) - 1)
+        if unchecked is not None:
+            poses, legs = unchecked
+            self.ctx.recorder.event(
+                "warning",
+                message=f"{hand.side}: {label}: no arc round the cube keeps the injected errors' "
+                f"margin ({why.strip()}); the first on the arm's branch for the believed poses",
+            )
+            self.ctx.recorder.event(
+                "swing",
+                hand=hand.side,
+                label=label,
+                legs=legs,
+                waypoints=len(poses),
+                margin_skipped=short,
+                margin=False,
+            )
+            return poses
         self.ctx.recorder.event(
             "warning",
             message=f"{hand.side}: {label}: no arc round the cube on the arm's branch "
@@ -1314,23 +1371,28 @@ class BimanualRubiksMachine:
         hand.grip_dir, hand.depth = world_dir, depth
         self._judge(label, hand)
 
-    def reach_margin(self) -> tuple[float, float]:
+    def reach_margin(self, sigmas: float | None = None) -> tuple[float, float]:
         """How far (m, rad) a target must stay reachable either way along (about) each world axis:
-        ``reach_sigmas`` standard deviations of the injected per-motion position error
+        ``reach_sigmas`` (or ``sigmas``) standard deviations of the injected per-motion position error
         (calibration and tracking together) and of the calibration's rotation (0: none injected)."""
-        err, k = self.config.errors, self.config.reach_sigmas or 0.0
+        err = self.config.errors
+        k = (self.config.reach_sigmas if sigmas is None else sigmas) or 0.0
         return k * math.hypot(err.calib_pos_std, err.tracking_std), k * math.radians(
             err.calib_rot_std_deg
         )
 
-    def reachable(self, hand: Hand, pose: Pose, seed: np.ndarray) -> bool:
+    def reachable(
+        self, hand: Hand, pose: Pose, seed: np.ndarray, sigmas: float | None = None
+    ) -> bool:
         """Whether ``pose`` (believed) and its neighbours within :meth:`reach_margin` (moved either way
         along each world axis, turned either way about each) all have an IK solution from ``seed``:
         whatever the injected errors put the arm's target within that box, it stays reachable.
-        Without ``reach_sigmas``: True (the caller has checked ``pose`` itself)."""
-        if self.config.reach_sigmas is None:
+        ``sigmas``: the box's size in standard deviations (default ``reach_sigmas``). Without either:
+        True (the caller has checked ``pose`` itself)."""
+        k = self.config.reach_sigmas if sigmas is None else sigmas
+        if k is None:
             return True
-        dp, dr = self.reach_margin()
+        dp, dr = self.reach_margin(k)
         poses = [pose]
         for axis in np.eye(3):
             for s in (1.0, -1.0):

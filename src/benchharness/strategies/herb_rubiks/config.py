@@ -122,6 +122,13 @@ class HerbPushGraspConfig(BimanualConfig):
     #: (Rubiks-1-5 on SAPIEN took a two-leg route at the first two hand-over re-grips and succeeded; with the
     #: direct arc only, waypoints out of reach left out, that trial jammed at twist 9).
     swing_routes: bool = True
+    #: a checked swing route's waypoints keep the injected errors' 3-sigma box in reach (the machine's
+    #: ``swing_reach_sigmas``; the PR2's ``reach_sigmas`` for its stand-offs and retreats, the same errors):
+    #: a re-grip's arc found reachable for the believed poses only had a waypoint the arm missed by 5.1 mm,
+    #: 1.5 deg with the errors, past ``ik_slack``, and SAPIEN Rubiks-5-5 seed 0 trial 3 ended `unreachable`
+    #: (at ffe4661 on the development VM; docs/herb_push_grasp.md, "Arc waypoints and the injected errors").
+    #: HERB's stand-offs and retreats keep no such margin (``reach_sigmas`` None).
+    swing_reach_sigmas: float | None = 3.0
     #: a two-slab giver grips again one slab deep before the hand-over turn (the taker holding meanwhile):
     #: the holder's fingers reach 33 mm into the cube, 4.6 mm past its centre, so a parallel take had to slide
     #: 19.6 mm of its 20 mm limit across its face to clear them, or found no grip (SAPIEN: Rubiks-1-10's first
