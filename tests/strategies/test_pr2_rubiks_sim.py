@@ -37,6 +37,12 @@ def test_pick_lifts_the_cube_to_the_twisting_pose_held_by_both_hands(make_ctx, b
     # first contact is found by the runner's step wrapper (not present in-process): the pair must be watched
     assert ctx.recorder.watched and ctx.recorder.watched[0][1] == ctx.robot.body
     assert out.final_state == ctx.item.initial  # no twist yet
+    # every grasp records its belief's error along the work axis (the grip's approach: world y here)
+    grasps = [e for e in ctx.recorder.events if e["kind"] == "grasp"]
+    assert [e["label"] for e in grasps][:2] == ["pick", "second grasp"], grasps
+    for e in grasps:
+        assert abs(abs(e["work_axis"][1]) - 1.0) < 0.01, e
+        assert abs(e["work_err_mm"]) < 6.0 and e["move_index"] == 0, e
 
 
 def _run_cli(tmp_path, strategy: str, backend: str, task: str = "Rubiks-1-5"):

@@ -338,7 +338,28 @@ class PR2Grasp:
             )
 
     def relocalise(self, m: BimanualRubiksMachine, hand: Hand, grip: Pose, label: str) -> Pose:
-        """Hook before a hand moves in to grip (dead reckoning: nothing; sensor-aided: pre-touch)."""
+        """Hook before a hand moves in to grip (dead reckoning: the record only; sensor-aided: pre-touch).
+
+        Dead reckoning moves in on its belief as it is. For the record only
+        (the truth is read, nothing is planned from it, no random number is
+        drawn) it logs that belief's error at the pre-grasp as a ``grasp``
+        event: along the work axis (the grip's approach; a pad lands on the
+        wrong slab past half a cubie) and in full, the same quantities as the
+        sensor-aided ``pretouch`` event's ``work_err_mm_before`` and
+        ``err_mm_before`` (bench/plot_work_axis_error.py).
+        """
+        true = m.cube.pose()
+        approach = grip.rotation.apply(along(self.approach_axis, 1.0))
+        dp = m.est.p - true.p
+        m.ctx.recorder.event(
+            "grasp",
+            hand=hand.side,
+            label=label,
+            move_index=m.move_index,
+            work_axis=np.round(approach, 3).tolist(),
+            work_err_mm=round(1000 * float(dp @ approach), 3),
+            err_mm=np.round(1000 * dp, 3).tolist(),
+        )
         return grip
 
     def open(self, m: BimanualRubiksMachine, hand: Hand) -> None:
