@@ -18,7 +18,6 @@ docs/strategies.md, "One-hand holds", has what it found.
 
 from __future__ import annotations
 
-import sys
 from typing import Any
 
 import numpy as np
@@ -110,11 +109,9 @@ def _install() -> None:
 
 
 def main() -> None:
-    _install()
-    from benchharness.cli.main import main as cli
+    from _trace_cli import run_traced
 
-    sys.argv = ["benchharness", *sys.argv[1:]]
-    cli()
+    run_traced(_install)
 
 
 if __name__ == "__main__":

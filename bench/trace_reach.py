@@ -16,7 +16,6 @@ docs/strategies.md, "An arm 141 mm from its command", has what it found.
 
 from __future__ import annotations
 
-import sys
 from typing import Any
 
 import numpy as np
@@ -98,15 +97,9 @@ def _install() -> None:
 
 
 def main() -> None:
-    args = sys.argv[1:]
-    if args[:1] == ["--trace-mm"]:
-        _state["mm"] = float(args[1])
-        args = args[2:]
-    _install()
-    from benchharness.cli.main import main as cli
+    from _trace_cli import run_traced
 
-    sys.argv = ["benchharness", *args]
-    cli()
+    run_traced(_install, {"--trace-mm": lambda v: _state.__setitem__("mm", float(v))})
 
 
 if __name__ == "__main__":

@@ -16,7 +16,6 @@ limited joints sit within 0.05 rad of their limits. Example::
 from __future__ import annotations
 
 import os
-import sys
 from typing import Any
 
 import numpy as np
@@ -82,11 +81,9 @@ def _install() -> None:
 
 
 def main() -> None:
-    _install()
-    from benchharness.cli.main import main as cli
+    from _trace_cli import run_traced
 
-    sys.argv = ["benchharness", *sys.argv[1:]]
-    cli()
+    run_traced(_install)
 
 
 if __name__ == "__main__":

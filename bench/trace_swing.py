@@ -19,7 +19,6 @@ docs/herb_push_grasp.md, "Arc waypoints and the injected errors", has what it fo
 from __future__ import annotations
 
 import math
-import sys
 from typing import Any
 
 import numpy as np
@@ -115,15 +114,9 @@ def _install() -> None:
 
 
 def main() -> None:
-    args = sys.argv[1:]
-    if args[:1] == ["--sigmas"]:
-        _state["sigmas"] = float(args[1])
-        args = args[2:]
-    _install()
-    from benchharness.cli.main import main as cli
+    from _trace_cli import run_traced
 
-    sys.argv = ["benchharness", *args]
-    cli()
+    run_traced(_install, {"--sigmas": lambda v: _state.__setitem__("sigmas", float(v))})
 
 
 if __name__ == "__main__":

@@ -17,7 +17,6 @@ indices only (default all). Example::
 from __future__ import annotations
 
 import math
-import sys
 from typing import Any
 
 import numpy as np
@@ -122,18 +121,15 @@ def _print_state(m, rot, info) -> None:
 
 
 def main() -> None:
-    args = sys.argv[1:]
-    while args[:1] in (["--every"], ["--moves"]):
-        if args[0] == "--every":
-            _state["every"] = float(args[1])
-        else:
-            _state["moves"] = {int(v) for v in args[1].split(",")}
-        args = args[2:]
-    _install()
-    from benchharness.cli.main import main as cli
+    from _trace_cli import run_traced
 
-    sys.argv = ["benchharness", *args]
-    cli()
+    run_traced(
+        _install,
+        {
+            "--every": lambda v: _state.__setitem__("every", float(v)),
+            "--moves": lambda v: _state.__setitem__("moves", {int(x) for x in v.split(",")}),
+        },
+    )
 
 
 if __name__ == "__main__":
