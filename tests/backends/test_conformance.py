@@ -568,6 +568,30 @@ def test_remove_and_replace_without_jump(backend: Backend):
     )
 
 
+def test_contacts_right_after_a_removal(backend: Backend):
+    """Contacts asked for between a body's removal and the next step are the last step's, less the
+    removed body's, on either engine. SAPIEN's own contact list then still refers to the removed
+    components: reading it crashed the process (a trace that read contacts right after the cube swapped
+    to its slabs). After the next step they are the engine's again."""
+    g = backend.add_ground()
+    a = backend.add_body([Box((0.03, 0.03, 0.03))], Pose([0.0, 0, 0.03]), 0.2)
+    b = backend.add_body([Box((0.03, 0.03, 0.03))], Pose([0.2, 0, 0.03]), 0.2)
+    backend.step(60)
+    before = backend.contacts(body_b=g)
+    assert {c.body_a for c in before} == {a, b}
+    backend.remove_body(a)
+    held = backend.contacts(body_b=g)
+    assert held and all(c.body_a == b for c in held)
+    assert [c.normal_force for c in held] == [c.normal_force for c in before if c.body_a == b]
+    flipped = backend.contacts(g, b)
+    assert flipped and all(c.body_a == g and c.normal @ [0, 0, 1] < -0.99 for c in flipped)
+    with pytest.raises(BackendError):  # a removed body is no body
+        backend.contacts(a)
+    backend.step(1)
+    after = backend.contacts(body_b=g)
+    assert after and all(c.body_a == b for c in after)
+
+
 # -- robustness --------------------------------------------------------------------
 def test_determinism_in_process(item):
     assert trajectory_digest(item.name, 0.3) == trajectory_digest(item.name, 0.3)

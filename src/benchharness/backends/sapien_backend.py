@@ -137,6 +137,10 @@ class SapienBackend(Backend):
         self._next_constraint = 1
         self._steps = 0
         self._roots: list[tuple[int, Any]] | None = None  #: movable bases, see _step_engine
+        #: the last step's contacts, read just before a body was removed and kept until the next step:
+        #: the engine's own list then still refers to the removed components, and reading it crashes
+        #: the process (seen: ``contacts()`` right after the cube swapped to its slabs)
+        self._held_contacts: list[Contact] | None = None
         self._closed = False
         self._grounds: dict[int, float] = {}
         self._materials: dict[float, Any] = {}
@@ -219,6 +223,7 @@ class SapienBackend(Backend):
             roots = self._roots
             self._engine_step()
             self._steps += 1
+            self._held_contacts = None
             for h, comp in roots:
                 lv = comp.linear_velocity
                 av = comp.angular_velocity
@@ -398,6 +403,9 @@ class SapienBackend(Backend):
 
     def remove_body(self, body: BodyId) -> None:
         b = self._b(body)
+        if self._held_contacts is None:
+            self._held_contacts = self.contacts()
+        self._held_contacts = [c for c in self._held_contacts if body not in (c.body_a, c.body_b)]
         for c, (_drive, pb_, cb_) in list(self._constraints.items()):
             if body in (pb_, cb_):
                 self.detach(c)
@@ -652,6 +660,21 @@ class SapienBackend(Backend):
             self._b(body_a)
         if body_b is not None:
             self._b(body_b)
+        if self._held_contacts is not None:  # a body was removed since the last step
+            out_held: list[Contact] = []
+            for c in self._held_contacts:
+                if (body_a is not None and c.body_a != body_a) or (
+                    body_a is None and body_b is not None and c.body_b != body_b
+                ):
+                    c = Contact(
+                        c.body_b, c.link_b, c.body_a, c.link_a, c.position, -c.normal,
+                        c.normal_force, c.distance,
+                    )  # fmt: skip
+                if (body_a is None or c.body_a == body_a) and (
+                    body_b is None or c.body_b == body_b
+                ):
+                    out_held.append(c)
+            return out_held
         inv_dt = 1.0 / self.config.timestep
         out: list[Contact] = []
         emap = self._entity_map
