@@ -579,6 +579,8 @@ class Backend(abc.ABC):
 
         With ``body_a`` given, every contact returned has that body as A (the
         pair is flipped, normal negated, when the engine reports it as B).
+        Between a body's removal and the next step: the last step's contacts
+        without the removed body's.
         """
 
     @abc.abstractmethod
