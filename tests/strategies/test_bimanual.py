@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import math
 
 import numpy as np
 import pytest
@@ -264,3 +265,122 @@ def test_swing_routes_and_giver_depth_are_herb_options_the_pr2_leaves_off():
     assert not pr2.swing_routes and pr2.giver_depth is None and pr2.ik_slack is None
     assert pr2.recentre_turn and herb.recentre_turn
     assert herb.swing_routes and herb.giver_depth == 1 and herb.ik_slack == 0.005
+
+
+class _RollArm:
+    """An arm for ``roll_about``: a fixed tool pose, IK that returns its seed (a step of ``jump`` rad on
+    joint 0 at waypoint ``jump_at``), and a record of the joint moves."""
+
+    def __init__(self, tool, jump_at=None, jump=0.0):
+        self.tool, self.jump_at, self.jump = tool, jump_at, jump
+        self.lower, self.upper = np.full(7, -3.0), np.full(7, 3.0)
+        self.calls = 0
+        self.moves = []
+
+    def base_pose(self):
+        from benchharness.geometry import Pose
+
+        return Pose(np.zeros(3))
+
+    def positions(self):
+        return np.zeros(7)
+
+    def tcp_pose(self):
+        return self.tool
+
+    def ik(self, mats, seed_q=None):
+        from types import SimpleNamespace
+
+        self.calls += 1
+        q = np.array(seed_q, dtype=float)
+        if self.calls == self.jump_at:
+            q[0] += self.jump
+        return SimpleNamespace(success=[True], q=q[None])
+
+    def move_to_joints(self, q, duration=None, settle=0.3):
+        self.moves.append((np.array(q), duration, settle))
+
+
+def _roll_setup(arm):
+    from types import SimpleNamespace
+
+    from benchharness.geometry import Pose
+    from benchharness.strategies.bimanual.machine import Hand
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    m = PushGraspStrategy()
+    m.ctx = SimpleNamespace(recorder=_Rec())
+    return m, Hand("right", arm, None, Pose(np.zeros(3)), arm.tool)
+
+
+def test_twist_turns_the_tool_about_the_layers_axis_not_the_palms():
+    """A layer whose axis is 4 mm off the palm's along the fingers (PyBullet Rubiks-1-20, U2 at move 14):
+    the wrist roll would carry it round a circle 8 mm across in a half turn; ``roll_waypoints`` keep the
+    point on the layer's axis where it is and the approach parallel, and end at the tool rolled by the
+    angle; ``roll_about`` moves through their chained IK to the wrist goal."""
+    from scipy.spatial.transform import Rotation
+
+    from benchharness.geometry import Pose
+
+    tool = Pose.from_rotation([0.9, -0.07, 1.1], Rotation.from_euler("x", -90, degrees=True))
+    m, hand = _roll_setup(_RollArm(tool))
+    fx = tool.rotation.apply([1.0, 0.0, 0.0])  # HERB: pinch across tool x, approach along tool z
+    az = tool.rotation.apply([0.0, 0.0, 1.0])
+    offset = -0.004
+    centre, poses = m.roll_waypoints(tool, offset, math.pi, 12)
+    assert np.allclose(centre, tool.p + offset * fx)
+    assert len(poses) == 12
+    for p in poses:
+        # the layer's axis stays put, the approach stays parallel to it
+        assert np.allclose(p.p + offset * p.rotation.apply([1.0, 0.0, 0.0]), centre, atol=1e-12)
+        assert np.allclose(p.rotation.apply([0.0, 0.0, 1.0]), az, atol=1e-12)
+    end = tool.rotation * Rotation.from_rotvec([0.0, 0.0, math.pi])
+    assert np.allclose((poses[-1].rotation * end.inv()).as_rotvec(), 0.0, atol=1e-9)
+    # the palm's axis (the plain wrist roll's) orbits: 8 mm off where it was after the half turn
+    assert np.linalg.norm(poses[-1].p - tool.p) == pytest.approx(0.008)
+    q_goal = np.zeros(7)
+    q_goal[-1] = math.pi
+    assert m.roll_about(hand, offset, q_goal, 2.0, 0)
+    n = math.ceil(180 / m.config.roll_step_deg)
+    assert len(hand.arm.moves) == n
+    assert hand.arm.moves[-1][0][-1] == pytest.approx(math.pi)
+    assert [d for _, d, _ in hand.arm.moves] == pytest.approx([2.0 / n] * n)
+    assert [s for _, _, s in hand.arm.moves] == [0.0] * (n - 1) + [0.2]
+    assert m.ctx.recorder.events[-1] == (
+        "roll",
+        {"hand": "right", "offset_mm": -4.0, "waypoints": n},
+    )
+
+
+def test_roll_about_refuses_a_branch_jump_and_moves_nothing():
+    from scipy.spatial.transform import Rotation
+
+    from benchharness.geometry import Pose
+
+    tool = Pose.from_rotation([0.9, -0.07, 1.1], Rotation.from_euler("x", -90, degrees=True))
+    m, hand = _roll_setup(_RollArm(tool, jump_at=3, jump=2.0))
+    q_goal = np.zeros(7)
+    q_goal[-1] = math.pi / 2
+    assert not m.roll_about(hand, 0.002, q_goal, 1.0, 4)
+    assert hand.arm.moves == []
+    kind, data = m.ctx.recorder.events[-1]
+    assert kind == "warning" and "twist 5: no smooth roll" in data["message"]
+
+
+def test_herb_roll_offset_reads_the_fingers_only_when_on():
+    """HERB's ``roll_offset``: None with ``roll_about_fingers`` off (the default: the twist rolls the wrist);
+    on, the middle of the fingers' inner sides, unless they are not a cube's width apart."""
+    from dataclasses import replace
+
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    sides = (-0.0325, 0.0245, 0.037, 0.037)  # 57 mm apart, their middle 4 mm towards tool -x
+    off = PushGraspStrategy()
+    off.grasp._pinch_sides = lambda m, hand: sides  # type: ignore[method-assign]
+    assert off.grasp.roll_offset(off, None) is None
+    on = PushGraspStrategy(replace(HerbPushGraspConfig(), roll_about_fingers=True))
+    on.grasp._pinch_sides = lambda m, hand: sides  # type: ignore[method-assign]
+    assert on.grasp.roll_offset(on, None) == pytest.approx(-0.004)
+    on.grasp._pinch_sides = lambda m, hand: (-0.04, 0.03, 0.037, 0.037)  # type: ignore[method-assign]
+    assert on.grasp.roll_offset(on, None) is None

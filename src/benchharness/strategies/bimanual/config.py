@@ -106,6 +106,11 @@ class BimanualConfig:
     swing_reach_sigmas: float | None = None
     #: largest joint change (rad) between two waypoints of a checked swing route (bigger: IK flipped the arm).
     swing_max_joint_step: float = 1.5
+    #: a twist whose grasp module measures the layer's axis (``roll_offset``) turns the tool about it in
+    #: waypoints at most this many degrees apart (:meth:`.machine.BimanualRubiksMachine.roll_about`; 15 deg is
+    #: what the PyBullet Rubiks-1-20 experiment in docs/herb_push_grasp.md ran); a module without it rolls the
+    #: wrist in one joint move.
+    roll_step_deg: float = 15.0
     #: how far the taker backs off along its approach (m) before the giver turns the cube in a hand-over:
     #: the turn carries the cube past where the taker's open fingers were.
     taker_retreat: float = 0.15

@@ -173,6 +173,11 @@ class GraspModule(Protocol):
     Optional: ``hand_points() -> np.ndarray`` (N x 3, tool frame, m), points filling the open
     hand; with it the machine keeps a free hand's moves to its stand-offs from sweeping through
     the cube (:meth:`BimanualRubiksMachine.transit`). A module without it is not checked.
+
+    Optional: ``roll_offset(m, hand) -> float | None``: where the gripped layer's axis lies from the
+    rotator's approach axis along its finger axis (m), as the hand's own closed fingers measure it (None:
+    no reading); with it a twist turns the tool about that axis (:meth:`BimanualRubiksMachine.roll_about`)
+    instead of rolling the wrist about the palm's. A module without it rolls the wrist.
     """
 
     approach_axis: int
@@ -1545,9 +1550,11 @@ class BimanualRubiksMachine:
                 message=f"twist {k + 1}: wrist roll limited to {math.degrees(q[-1]):.0f}° "
                 f"({math.degrees(want - q[-1]):.0f}° short)",
             )
-        rot.arm.move_to_joints(
-            q, duration=self.config.quarter_turn_s * abs(t.quarter_turns), settle=0.2
-        )
+        duration = self.config.quarter_turn_s * abs(t.quarter_turns)
+        offset_fn = getattr(self.grasp, "roll_offset", None)
+        offset = offset_fn(self, rot) if offset_fn is not None else None
+        if offset is None or not self.roll_about(rot, offset, q, duration, k):
+            rot.arm.move_to_joints(q, duration=duration, settle=0.2)
         rolled = Rotation.from_rotvec(along(self.grasp.approach_axis, delta))
         rot.cmd = rot.last_grip = Pose.from_rotation(rot.cmd.p, rot.cmd.rotation * rolled)
         self.grasp.open(self, rot)
@@ -1573,6 +1580,65 @@ class BimanualRubiksMachine:
         # the rotator backs off (opening again: it still counts as holding); the next regrasp or
         # hand-over takes it from there
         self.release_hand(rot)
+
+    def roll_waypoints(
+        self, tool: Pose, offset: float, angle: float, n: int
+    ) -> tuple[np.ndarray, list[Pose]]:
+        """The layer's axis (a point on it, world) ``offset`` along ``tool``'s finger axis, and ``tool`` turned
+        about it, parallel to its approach, by ``angle`` in ``n`` equal steps (the last at ``angle``)."""
+        fingers = tool.rotation.apply(along(self.grasp.finger_axis, 1.0))
+        approach = tool.rotation.apply(along(self.grasp.approach_axis, 1.0))
+        centre = tool.p + offset * fingers
+        return centre, [
+            rotate_about_point(tool, centre, approach, angle * i / n) for i in range(1, n + 1)
+        ]
+
+    def roll_about(
+        self, hand: Hand, offset: float, q_goal: np.ndarray, duration: float, k: int
+    ) -> bool:
+        """Twist by turning ``hand``'s tool about the layer's axis, ``offset`` (m) along its finger axis from
+        its approach axis as its own fingers measure it, by the wrist roll ``q_goal`` asks for; False (nothing
+        moved) when the chained IK of the waypoints does not hold the arm on its branch.
+
+        The wrist rolls about the palm's axis; a layer whose axis is off it is carried round on a circle of
+        that radius, and the holder's two-fingertip pinch, a hinge, lets the whole cube turn about its pinch
+        axis (measured, PyBullet Rubiks-1-20 seed 0, U2 at move 14: the axis 4.0 mm off, the cube rolled
+        15 deg about the holder's pinch axis and later fell out of a one-slab give grip;
+        docs/herb_push_grasp.md). The waypoints are relative to the arm's own measured tool pose (FK of its
+        joints) and solved by its own IK: no belief and no injected calibration enter, as in the joint-space
+        roll they replace. Waypoints every ``roll_step_deg`` at most; each IK is seeded with the wrist
+        at its share of the roll, and a step that moves any other joint more than
+        ``swing_max_joint_step`` (another branch) refuses the whole roll.
+        """
+        arm = hand.arm
+        q0 = np.clip(arm.positions(), arm.lower, arm.upper)
+        angle = float(q_goal[-1] - q0[-1])
+        n = max(1, math.ceil(abs(angle) / math.radians(self.config.roll_step_deg) - 1e-9))
+        centre, poses = self.roll_waypoints(arm.tcp_pose(), offset, angle, n)
+        base = arm.base_pose()
+        qs, q = [], q0
+        for i, pose in enumerate(poses, start=1):
+            seed = np.array(q, dtype=float)
+            seed[-1] = q0[-1] + angle * i / n
+            res = arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
+            q1 = np.asarray(res.q[0], dtype=float)
+            if not res.success[0] or float(np.max(np.abs(q1[:-1] - q[:-1]))) > (
+                self.config.swing_max_joint_step
+            ):
+                self.ctx.recorder.event(
+                    "warning",
+                    message=f"twist {k + 1}: no smooth roll about the layer's axis "
+                    f"({1000 * offset:+.1f} mm off the palm's, waypoint {i} of {n}): the wrist rolls",
+                )
+                return False
+            qs.append(q1)
+            q = q1
+        for i, qi in enumerate(qs, start=1):
+            arm.move_to_joints(qi, duration=duration / n, settle=0.2 if i == n else 0.0)
+        self.ctx.recorder.event(
+            "roll", hand=hand.side, offset_mm=round(1000 * offset, 2), waypoints=n
+        )
+        return True
 
     def _regrasp(self, a: Regrasp, k: int) -> None:
         if a.kind == "unwind":  # the rotator lets go, rolls back (a fresh choice) and re-grips

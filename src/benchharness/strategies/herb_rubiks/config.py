@@ -166,6 +166,13 @@ class HerbPushGraspConfig(BimanualConfig):
     #: 1/5 (4/5 without): the FK offset after a re-centring was often no smaller (a held cube moves with the
     #: re-closing fingers; overshoots of 1.6 -> 1.8 mm, 3.2 -> 4.2 mm), and each re-close shook the cube.
     centre_tolerance: float | None = None
+    #: a twist turns the tool about the layer's axis as the rotator's closed fingers measure it (``roll_offset``,
+    #: the machine's ``roll_about``) instead of rolling the wrist about the palm's axis. Off: measured on
+    #: PyBullet Rubiks-1-20 seed 0 it removes the cause of the fall after move 14 (a U2 rolled 4.0 mm off the
+    #: layer's axis turned the cube 15 deg in the holder's pinch; turned about the measured axis at that move
+    #: only, 1.0 deg, and the trial succeeded), but on for every twist R2 at move 5 slipped 14 deg short and
+    #: the cube fell (docs/herb_push_grasp.md, "The fall after Rubiks-1-20's move 14").
+    roll_about_fingers: bool = False
     #: the fingers' inner sides must be this close to the cube's width apart (m) to be read as its side faces.
     centre_width_tolerance: float = 0.006
     #: largest joint change (rad) allowed between two hand-over waypoints (bigger = IK flipped the arm).

@@ -699,6 +699,19 @@ class PushGrasp:
             )
         return again
 
+    def roll_offset(self, m: BimanualRubiksMachine, hand: Hand) -> float | None:
+        """The gripped layer's axis from the tool's approach axis along the pinch (m), from the closed outer
+        fingers: the middle of their inner sides (FK of the hand's joints, :meth:`_pinch_sides`); None when
+        the two are not a cube's width apart (``centre_width_tolerance``). Relative to the hand itself: no
+        belief, no calibration. The machine's twist turns the tool about it (``roll_about``). None whenever
+        ``roll_about_fingers`` is off (the default: see there)."""
+        if not self.config.roll_about_fingers:
+            return None
+        x_neg, x_pos, _, _ = self._pinch_sides(m, hand)
+        if abs(x_pos - x_neg - 2 * CUBE_HALF) > self.config.centre_width_tolerance:
+            return None
+        return 0.5 * (x_neg + x_pos)
+
     def twist_diagnostics(self, m: BimanualRubiksMachine, body_axis: str) -> dict | None:
         """Which slabs each hand's links touch (engine contacts): a diagnostic for the recorder."""
         out: dict[str, Any] = {}
