@@ -28,11 +28,27 @@ __all__ = [
     "DriveCommand",
     "DriveState",
     "as_array",
+    "contact_side",
     "drive_command",
 ]
 
 #: stand-in for an unlimited force cap (engines want finite numbers)
 UNLIMITED_FORCE = 1.0e9
+
+
+def contact_side(a: BodyId, b: BodyId, body_a: BodyId | None, body_b: BodyId | None) -> bool | None:
+    """How an engine contact between bodies ``a`` and ``b`` answers ``contacts(body_a, body_b)``.
+
+    False: as the engine gives it; True: flipped (``b`` first, the normal negated), so that a given
+    ``body_a`` is always A and, with only ``body_b`` given, that body is B; None: not asked for.
+    """
+    flip = (body_a is not None and a != body_a) or (
+        body_a is None and body_b is not None and b != body_b
+    )
+    first, second = (b, a) if flip else (a, b)
+    if (body_a is not None and first != body_a) or (body_b is not None and second != body_b):
+        return None
+    return flip
 
 
 def as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:

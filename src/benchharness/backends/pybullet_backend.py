@@ -30,7 +30,7 @@ import pybullet as pb
 
 from ..geometry import Pose
 from . import PYBULLET_CAPABILITIES
-from ._bodies import BodyRecord, BodyTable, as_array, drive_command
+from ._bodies import BodyRecord, BodyTable, as_array, contact_side, drive_command
 from ._urdf import BodyInertial, ground_ray_fixup, mass_properties, parse_urdf
 from .interface import (
     Backend,
@@ -949,22 +949,18 @@ class PyBulletBackend(Backend):
             a, bb = self._uid2h.get(c[1]), self._uid2h.get(c[2])
             if a is None or bb is None:
                 continue
+            flip = contact_side(a, bb, body_a, body_b)
+            if flip is None:
+                continue
             la, lb = self._bodies[a].index_link.get(c[3]), self._bodies[bb].index_link.get(c[4])
             pos = 0.5 * (np.asarray(c[5]) + np.asarray(c[6]))
             nrm = np.asarray(c[7], dtype=float)
-            con = Contact(a, la, bb, lb, pos, nrm, max(0.0, float(c[9])), float(c[8]))
-            if (body_a is not None and a != body_a) or (
-                body_a is None and body_b is not None and bb != body_b
-            ):
-                con = Contact(bb, lb, a, la, pos, -nrm, con.normal_force, con.distance)
-            if (
-                body_a is not None
-                and con.body_a != body_a
-                or body_b is not None
-                and con.body_b != body_b
-            ):
-                continue
-            out.append(con)
+            fn, dist = max(0.0, float(c[9])), float(c[8])
+            out.append(
+                Contact(bb, lb, a, la, pos, -nrm, fn, dist)
+                if flip
+                else Contact(a, la, bb, lb, pos, nrm, fn, dist)
+            )
         return out
 
     def ray_cast(

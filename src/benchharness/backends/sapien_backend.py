@@ -31,7 +31,7 @@ import numpy as np
 
 from ..geometry import Pose
 from . import SAPIEN_CAPABILITIES
-from ._bodies import BodyRecord, BodyTable, as_array, drive_command
+from ._bodies import BodyRecord, BodyTable, as_array, contact_side, drive_command
 from ._urdf import (
     BodyInertial,
     collision_only_copy,
@@ -663,17 +663,23 @@ class SapienBackend(Backend):
         if self._held_contacts is not None:  # a body was removed since the last step
             out_held: list[Contact] = []
             for c in self._held_contacts:
-                if (body_a is not None and c.body_a != body_a) or (
-                    body_a is None and body_b is not None and c.body_b != body_b
-                ):
-                    c = Contact(
-                        c.body_b, c.link_b, c.body_a, c.link_a, c.position, -c.normal,
-                        c.normal_force, c.distance,
+                flip = contact_side(c.body_a, c.body_b, body_a, body_b)
+                if flip is None:
+                    continue
+                out_held.append(
+                    Contact(
+                        c.body_b,
+                        c.link_b,
+                        c.body_a,
+                        c.link_a,
+                        c.position,
+                        -c.normal,
+                        c.normal_force,
+                        c.distance,
                     )  # fmt: skip
-                if (body_a is None or c.body_a == body_a) and (
-                    body_b is None or c.body_b == body_b
-                ):
-                    out_held.append(c)
+                    if flip
+                    else c
+                )
             return out_held
         inv_dt = 1.0 / self.config.timestep
         out: list[Contact] = []
@@ -683,16 +689,11 @@ class SapienBackend(Backend):
             e1 = emap.get(c.bodies[1].entity.per_scene_id)
             if e0 is None or e1 is None:
                 continue
+            flip = contact_side(e0[0], e1[0], body_a, body_b)
+            if flip is None:
+                continue
             # PhysX: the normal points from the second body towards the first
-            (ha, la), (hb, lb), sign = e0, e1, 1.0
-            if (body_a is not None and ha != body_a) or (
-                body_a is None and body_b is not None and hb != body_b
-            ):
-                (ha, la), (hb, lb), sign = e1, e0, -1.0
-            if body_a is not None and ha != body_a:
-                continue
-            if body_b is not None and hb != body_b:
-                continue
+            (ha, la), (hb, lb), sign = (e1, e0, -1.0) if flip else (e0, e1, 1.0)
             for p in c.points:
                 nrm = sign * np.asarray(p.normal, dtype=float)
                 imp = np.asarray(p.impulse, dtype=float)
