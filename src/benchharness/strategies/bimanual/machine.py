@@ -1615,14 +1615,12 @@ class BimanualRubiksMachine:
         angle = float(q_goal[-1] - q0[-1])
         n = max(1, math.ceil(abs(angle) / math.radians(self.config.roll_step_deg) - 1e-9))
         centre, poses = self.roll_waypoints(arm.tcp_pose(), offset, angle, n)
-        base = arm.base_pose()
         qs, q = [], q0
         for i, pose in enumerate(poses, start=1):
             seed = np.array(q, dtype=float)
             seed[-1] = q0[-1] + angle * i / n
-            res = arm.ik((base.inv() * pose).as_matrix()[None], seed_q=seed)
-            q1 = np.asarray(res.q[0], dtype=float)
-            if not res.success[0] or float(np.max(np.abs(q1[:-1] - q[:-1]))) > (
+            q1 = self.ik_q(hand, pose, seed)
+            if q1 is None or float(np.max(np.abs(q1[:-1] - q[:-1]))) > (
                 self.config.swing_max_joint_step
             ):
                 self.ctx.recorder.event(

@@ -97,6 +97,19 @@ def _open_hand_points() -> np.ndarray:
     return out
 
 
+def _belief_error(est: Pose, true: Pose, approach: np.ndarray) -> tuple[float, list, list]:
+    """A belief's error against the engine's truth, for the record only: along the grip's approach (the
+    work axis: past half a cubie a pad lands on the wrong slab) and in full (mm), and its turn (deg).
+    Dead reckoning's ``grasp`` event and sensor-aided's ``pretouch`` event report the same quantities."""
+    dp = est.p - true.p
+    rv = (est.rotation * true.rotation.inv()).as_rotvec()
+    return (
+        round(1000 * float(dp @ approach), 3),
+        np.round(1000 * dp, 3).tolist(),
+        np.round(np.degrees(rv), 3).tolist(),
+    )
+
+
 class PR2Grasp:
     """The PR2's grasp module: side grips of a parallel gripper (tool x = approach, y = fingers)."""
 
@@ -348,17 +361,16 @@ class PR2Grasp:
         sensor-aided ``pretouch`` event's ``work_err_mm_before`` and
         ``err_mm_before`` (bench/plot_work_axis_error.py).
         """
-        true = m.cube.pose()
         approach = grip.rotation.apply(along(self.approach_axis, 1.0))
-        dp = m.est.p - true.p
+        work, err, _ = _belief_error(m.est, m.cube.pose(), approach)
         m.ctx.recorder.event(
             "grasp",
             hand=hand.side,
             label=label,
             move_index=m.move_index,
             work_axis=np.round(approach, 3).tolist(),
-            work_err_mm=round(1000 * float(dp @ approach), 3),
-            err_mm=np.round(1000 * dp, 3).tolist(),
+            work_err_mm=work,
+            err_mm=err,
         )
         return grip
 
@@ -709,18 +721,8 @@ class PR2SensorAidedGrasp(PR2Grasp):
             m.reanchor()  # what the holding hand believes it carries
         # the record (truth read for it only): belief error before and after, along the work axis too
         true = m.cube.pose()
-
-        def errors(est: Pose) -> tuple[float, list[float], list[float]]:
-            dp = est.p - true.p
-            rv = (est.rotation * true.rotation.inv()).as_rotvec()
-            return (
-                round(1000 * float(dp @ approach), 3),
-                np.round(1000 * dp, 3).tolist(),
-                np.round(np.degrees(rv), 3).tolist(),
-            )
-
-        w0, p0, r0 = errors(before)
-        w1, p1, r1 = errors(m.est)
+        w0, p0, r0 = _belief_error(before, true, approach)
+        w1, p1, r1 = _belief_error(m.est, true, approach)
         # the same after the sweeps against the truth as this arm's kinematic model sees it (its
         # calibration offset removed, for the record only): what its grip depends on, and what the
         # posterior std describes
