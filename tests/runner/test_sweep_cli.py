@@ -108,6 +108,42 @@ def test_grid_is_the_product_and_run_keys_match_run(store_path):
         assert len(store.trials()) == 20
 
 
+def test_pool_runs_one_trial_runs_of_a_grid_side_by_side(store_path, tmp_path, monkeypatch):
+    """A grid of one-trial runs (the Rubiks-1-N tiers) keeps both workers busy: each trial of
+    ``test-rendezvous`` finishes only while another trial runs beside it (it fails after 20 s
+    alone), which a pool that ran the grid's runs one after another never gives it."""
+    monkeypatch.setenv("SWEEP_TEST_PIDDIR", str(tmp_path))
+    monkeypatch.setenv("SWEEP_TEST_MEET", "2")
+    res = _invoke(
+        "--tasks",
+        "Rubiks-1-5",
+        "--robots",
+        "test-stub",
+        "--strategies",
+        "test-rendezvous",
+        "--seeds",
+        "0,1",
+        "--plugin",
+        PLUGIN,
+        "--plugin",
+        "sweep_testplugins",
+        "--workers",
+        "2",
+        "--store",
+        str(store_path),
+        "--json",
+    )
+    assert res.exit_code == 0, res.output
+    assert [r["ran"] for r in json.loads(res.stdout)["runs"]] == [1, 1]
+    with ResultsStore(store_path, read_only=True) as store:
+        rows = store.trials()
+    assert [(t.seed, t.status.value, t.message) for t in sorted(rows, key=lambda t: t.seed)] == [
+        (0, "success", ""),
+        (1, "success", ""),
+    ]
+    assert len(list(tmp_path.glob("*.here"))) == 2  # two worker processes
+
+
 def test_product_skips_other_benchmark_with_a_note(store_path):
     res = _invoke(
         "--tasks",

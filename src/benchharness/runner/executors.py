@@ -4,8 +4,10 @@ Both keep :mod:`.sweep`'s semantics: run keys, resume (stored trials are
 skipped), claims in the store, and the driver as the one writer of the
 SQLite store, writing each trial as it finishes.
 
-* ``pool`` runs each run of the grid in turn through :func:`.sweep.run_sweep`
-  (its worker processes, watchdog and crash retry).
+* ``pool`` runs the whole grid through one process pool,
+  :func:`.sweep.run_sweeps` (its worker processes, watchdog and crash retry):
+  a freed worker takes the next trial of any run, so one-trial runs run side
+  by side.
 * ``ray`` submits every pending trial of the grid as one Ray task
   (``num_cpus=1``). Ray retries a task whose worker process dies
   (``max_retries`` times); after that the trial is stored as
@@ -29,7 +31,7 @@ from .causes import FailureCause
 from .records import TrialRecord
 from .spec import RunSpec
 from .store import ClaimOwner, ResultsStore
-from .sweep import LEASE_S, SweepReport, _failure_record, _Signals, prepare, run_sweep
+from .sweep import LEASE_S, SweepReport, _failure_record, _Signals, prepare, run_sweeps
 from .trial import execute_trial
 
 __all__ = ["EXECUTORS", "RAY_MISSING", "loopback_env", "pending_trials", "run_grid"]
@@ -66,10 +68,9 @@ def run_grid(
 ) -> list[SweepReport]:
     """Run every pending trial of ``specs``; one :class:`SweepReport` per run, in order."""
     if executor == "pool":
-        return [
-            run_sweep(spec, store, workers=workers, retry_failed=retry_failed, on_record=on_record)
-            for spec in specs
-        ]
+        return run_sweeps(
+            specs, store, workers=workers, retry_failed=retry_failed, on_record=on_record
+        )
     if executor == "ray":
         return _run_ray(specs, store, address, num_cpus, max_retries, retry_failed, on_record)
     raise ValueError(f"--executor {executor!r}: one of {', '.join(EXECUTORS)}")

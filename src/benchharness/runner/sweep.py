@@ -7,6 +7,9 @@
   sweeps of the same run split the trials; when its own are done a sweep waits
   for the ones another live sweep is running, and takes over any whose owner
   died (at once on this host, when the lease lapses from another).
+* A grid (:func:`run_sweeps`) shares one pool across its runs: a worker that
+  frees up takes the next claimable trial of the first run that has one, so
+  a grid of one-trial runs (the Rubiks-1-N tiers) keeps every worker busy.
 * Workers are *spawned* (not forked): a fresh interpreter per worker, no
   inherited engine state or locks. Each trial builds its own world, so
   results depend only on (run, trial index), not on the worker count.
@@ -34,7 +37,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from multiprocessing.connection import wait
@@ -57,6 +60,7 @@ __all__ = [
     "default_workers",
     "prepare",
     "run_sweep",
+    "run_sweeps",
     "watchdog_limit",
 ]
 
@@ -224,13 +228,14 @@ class _Claims:
         retry_failed: bool,
         forced: set[int],
         wait_for_others: bool,
+        owner: ClaimOwner,
     ) -> None:
         self.store, self.spec, self.report = store, spec, report
         self.queue = list(pending)
         self.busy: list[int] = []
         self.retry_failed, self.forced = retry_failed, forced
         self.wait_for_others = wait_for_others
-        self.owner = ClaimOwner.new()
+        self.owner = owner
         self.since = time.time()
         self._next_look = 0.0
 
@@ -266,40 +271,59 @@ class _Claims:
         self.queue.insert(0, i)  # still ours: the claim is re-taken at once
 
 
+def _next_job(runs: list[_Claims]) -> tuple[_Claims, int] | None:
+    """The next claimable trial of the first run (in grid order) that has one."""
+    for claims in runs:
+        if (i := claims.next()) is not None:
+            return claims, i
+    return None
+
+
+def _waiting(runs: list[_Claims]) -> bool:
+    return any([claims.waiting() for claims in runs])  # every run's (each records its busy trials)
+
+
 def _run_in_workers(
     ctx: Any,
     workers: int,
-    claims: _Claims,
-    spec: RunSpec,
+    runs: list[_Claims],
     video: VideoSpec | None,
-    finish: Callable[[TrialRecord], None],
+    finish: Callable[[_Claims, TrialRecord], None],
     signals: _Signals,
 ) -> None:
-    limit = watchdog_limit(spec.budget)
     pool: list[Worker] = []
-    crashed: set[int] = set()
+    run_of: dict[Worker, _Claims] = {}  # the run of each worker's last trial
+    crashed: set[tuple[str, int]] = set()
+
+    def give(w: Worker, job: tuple[_Claims, int]) -> None:
+        run_of[w] = job[0]
+        w.give((job[0].spec, job[1], video))
+
+    def limit(w: Worker) -> float | None:
+        return watchdog_limit(run_of[w].spec.budget)
+
     try:
         while True:
             for w in [w for w in pool if w.index is None and not w.proc.is_alive()]:
                 w.stop()  # an idle worker that died: replaced below if there is work
                 pool.remove(w)
             for w in pool:
-                if w.index is None and (i := claims.next()) is not None:
-                    w.give((spec, i, video))
-            while len(pool) < workers and (i := claims.next()) is not None:
+                if w.index is None and (job := _next_job(runs)) is not None:
+                    give(w, job)
+            while len(pool) < workers and (job := _next_job(runs)) is not None:
                 pool.append(Worker(ctx))
-                pool[-1].give((spec, i, video))
+                give(pool[-1], job)
             running = [w for w in pool if w.index is not None]
             if not running:
-                if not claims.waiting():
+                if not _waiting(runs):
                     return
                 time.sleep(0.5)
                 continue
             now = time.monotonic()
             deadlines = [
-                (w.started if w.started is not None else w.sent + 60.0) + limit
+                (w.started if w.started is not None else w.sent + 60.0) + lim
                 for w in running
-                if limit is not None
+                if (lim := limit(w)) is not None
             ]
             timeout = max(0.0, min([*deadlines, now + 1.0]) - now)
             ready = wait([w.conn for w in running] + [w.proc.sentinel for w in running], timeout)
@@ -314,53 +338,55 @@ def _run_in_workers(
                     else:
                         w.index = None
                         with signals.critical():
-                            finish(msg[1])
+                            finish(run_of[w], msg[1])
                 if w.index is not None and not w.proc.is_alive():  # died mid-trial
                     i, w.index = w.index, None
+                    claims = run_of[w]
                     w.stop(kill=True)
                     pool.remove(w)
-                    if i in crashed:
+                    if (claims.spec.run_key, i) in crashed:
                         detail = f"exit code {w.proc.exitcode}"
                         with signals.critical():
                             finish(
+                                claims,
                                 _failure_record(
-                                    spec,
+                                    claims.spec,
                                     i,
                                     FailureCause.SIMULATOR_ERROR,
                                     f"the worker process died while running this trial, twice ({detail})",
                                     time.monotonic() - w.sent,
-                                )
+                                ),
                             )
                     else:
-                        crashed.add(i)
+                        crashed.add((claims.spec.run_key, i))
                         claims.requeue(i)
-            if limit is None:
-                continue
             now = time.monotonic()
             for w in list(pool):
                 t0 = w.started if w.started is not None else w.sent + 60.0  # 60 s to start up
-                if w.index is not None and now - t0 > limit:
+                if w.index is not None and (lim := limit(w)) is not None and now - t0 > lim:
                     i, w.index = w.index, None
+                    claims = run_of[w]
                     w.stop(kill=True)
                     pool.remove(w)
-                    budget = spec.budget.wall_s
+                    budget = claims.spec.budget.wall_s
                     why = (
                         f"wall-time budget of {budget:g} s spent"
                         if budget is not None
-                        else f"no wall-time budget set; the backstop of {limit:g} s "
+                        else f"no wall-time budget set; the backstop of {lim:g} s "
                         f"(max({BACKSTOP_MIN_S:g} s, {BACKSTOP_FACTOR:g} × the simulated budget)) "
                         "passed"
                     )
                     with signals.critical():
                         finish(
+                            claims,
                             _failure_record(
-                                spec,
+                                claims.spec,
                                 i,
                                 FailureCause.TIMEOUT,
                                 f"{why} and the trial did not stop (stuck outside Python?); "
                                 f"the parent ended its worker process after {now - t0:.1f} s",
                                 now - t0,
-                            )
+                            ),
                         )
     except KeyboardInterrupt:
         # Store what already finished (results sent but not yet read); stop the rest.
@@ -370,13 +396,84 @@ def _run_in_workers(
                     msg = w.conn.recv()
                     if msg[0] == "done":
                         w.index = None
-                        finish(msg[1])
+                        finish(run_of[w], msg[1])
             except (EOFError, OSError):
                 pass
         raise
     finally:
         for w in pool:
             w.stop(kill=w.index is not None)
+
+
+def _start(
+    spec: RunSpec,
+    store: ResultsStore,
+    owner: ClaimOwner,
+    *,
+    trials: str | None,
+    retry_failed: bool,
+    video: VideoSpec | None,
+    wait_for_others: bool,
+) -> _Claims:
+    """One run's report and its queue of pending trials (every name checked first)."""
+    plan = prepare(spec)
+    selected = parse_trial_selection(trials, sorted(plan.items))
+    if video is not None and video.trial_index not in plan.items:
+        raise ValueError(f"--video-trial {video.trial_index}: this task has trials 1..{plan.total}")
+    done = store.finished(spec.run_key, retry_failed=retry_failed)
+    forced = {video.trial_index} if video is not None else set()
+    pending = [i for i in selected if i not in done or i in forced]
+    report = SweepReport(
+        spec, plan, selected, skipped=[i for i in selected if i in done and i not in forced]
+    )
+    return _Claims(
+        store,
+        spec,
+        pending,
+        report,
+        retry_failed=retry_failed,
+        forced=forced,
+        wait_for_others=wait_for_others,
+        owner=owner,
+    )
+
+
+def _drive(
+    runs: list[_Claims],
+    store: ResultsStore,
+    workers: int,
+    video: VideoSpec | None,
+    on_record: Callable[[TrialRecord], None] | None,
+) -> None:
+    """Run the runs' pending trials: in one pool of ``workers`` processes, or here (``workers=0``)."""
+    for claims in runs:
+        store.ensure_run(claims.spec, claims.report.plan.benchmark, claims.report.plan.total)
+
+    def finish(claims: _Claims, rec: TrialRecord) -> None:
+        if not store.write(rec, claims.owner):
+            claims.report.by_others.append(rec.trial_index)  # our lease lapsed; the taker stores it
+            return
+        claims.report.records.append(rec)
+        if on_record is not None:
+            on_record(rec)
+
+    owner = runs[0].owner if runs else ClaimOwner.new()
+    with _Signals() as signals, store.keep_claims(owner, LEASE_S):
+        if workers > 0:
+            ctx = multiprocessing.get_context("spawn")
+            _run_in_workers(ctx, workers, runs, video, finish, signals)
+            return
+        while True:
+            job = _next_job(runs)
+            if job is None:
+                if not _waiting(runs):
+                    return
+                time.sleep(0.5)
+                continue
+            with _quiet_stdout():
+                rec = execute_trial(job[0].spec, job[1], video)
+            with signals.critical():
+                finish(job[0], rec)
 
 
 def run_sweep(
@@ -397,50 +494,51 @@ def run_sweep(
     only the per-step budget check and the wall alarm apply. Raises
     :class:`SweepInterrupted` on Ctrl-C/SIGTERM once finished trials are stored.
     """
-    plan = prepare(spec)
-    selected = parse_trial_selection(trials, sorted(plan.items))
-    if video is not None and video.trial_index not in plan.items:
-        raise ValueError(f"--video-trial {video.trial_index}: this task has trials 1..{plan.total}")
-    store.ensure_run(spec, plan.benchmark, plan.total)
-    done = store.finished(spec.run_key, retry_failed=retry_failed)
-    forced = {video.trial_index} if video is not None else set()
-    pending = [i for i in selected if i not in done or i in forced]
-    report = SweepReport(
-        spec, plan, selected, skipped=[i for i in selected if i in done and i not in forced]
-    )
-    if on_start is not None:
-        on_start(report, len(pending))
-    claims = _Claims(
-        store,
+    claims = _start(
         spec,
-        pending,
-        report,
+        store,
+        ClaimOwner.new(),
+        trials=trials,
         retry_failed=retry_failed,
-        forced=forced,
+        video=video,
         wait_for_others=wait_for_others,
     )
+    if on_start is not None:
+        on_start(claims.report, len(claims.queue))
+    _drive([claims], store, workers, video, on_record)
+    return claims.report
 
-    def finish(rec: TrialRecord) -> None:
-        if not store.write(rec, claims.owner):
-            report.by_others.append(rec.trial_index)  # our lease lapsed; the taker stores it
-            return
-        report.records.append(rec)
-        if on_record is not None:
-            on_record(rec)
 
-    with _Signals() as signals, store.keep_claims(claims.owner, LEASE_S):
-        if workers > 0:
-            ctx = multiprocessing.get_context("spawn")
-            _run_in_workers(ctx, workers, claims, spec, video, finish, signals)
-            return report
-        while True:
-            i = claims.next()
-            if i is None:
-                if not claims.waiting():
-                    return report
-                time.sleep(0.5)
-                continue
-            with _quiet_stdout():
-                rec = execute_trial(spec, i, video)
-            with signals.critical():
-                finish(rec)
+def run_sweeps(
+    specs: Sequence[RunSpec],
+    store: ResultsStore,
+    *,
+    workers: int = 1,
+    retry_failed: bool = False,
+    on_record: Callable[[TrialRecord], None] | None = None,
+    wait_for_others: bool = True,
+) -> list[SweepReport]:
+    """Every pending trial of several runs (a grid) through one pool; one report per run, in order.
+
+    Why one pool, not :func:`run_sweep` per run: the Rubiks-1-N tiers are runs
+    of one trial, and a grid of them run in turn kept one worker of two busy
+    (measured: 12 one-trial runs with ``--workers 2`` took the 1-worker wall
+    time, BENCHMARKS.md "sweep scaling"). Trials are given out in grid order;
+    each depends only on (run, index), so the rows are the same for any
+    worker count.
+    """
+    owner = ClaimOwner.new()  # one lease holder for the whole grid
+    runs = [
+        _start(
+            spec,
+            store,
+            owner,
+            trials=None,
+            retry_failed=retry_failed,
+            video=None,
+            wait_for_others=wait_for_others,
+        )
+        for spec in specs
+    ]
+    _drive(runs, store, workers, None, on_record)
+    return [claims.report for claims in runs]
