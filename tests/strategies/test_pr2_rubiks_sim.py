@@ -133,6 +133,12 @@ REFERENCE_ROWS: dict[str, dict[str, tuple[float, float, str]]] = {
         "pybullet": (95.54583333333333, 100.75416666666666, "42cb036bff53a737"),
         "sapien": (87.35416666666666, 92.5375, "8c5ccfc18da625d2"),
     },
+    # recorded 2026-12-03 (Intel VM, twice in fresh processes, the same rows): PyBullet's score and
+    # time are the earlier machines' to the last bit, the digests are not (the diagnostics' floats)
+    "Intel(R) Xeon(R) Processor | avx,avx2,avx512_bf16,avx512_bitalg,avx512_fp16,avx512_vbmi2,avx512_vnni,avx512_vpopcntdq,avx512bw,avx512cd,avx512dq,avx512f,avx512ifma,avx512vbmi,avx512vl,avx_vnni,fma,sse4_1,sse4_2 | numpy 2.4.6 | scipy 1.17.1 | torch 2.13.0+cpu | pytorch-kinematics 0.10.0 | pybullet 3.2.7 | sapien 3.0.3 | filterpy 2.0.0": {
+        "pybullet": (95.78750000000001, 100.99583333333334, "7a7dc8f4797881d9"),
+        "sapien": (87.35416666666666, 92.5375, "77758eba51e4d12a"),
+    },
 }
 
 
