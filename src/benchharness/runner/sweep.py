@@ -523,7 +523,7 @@ def run_sweeps(
     Why one pool, not :func:`run_sweep` per run: the Rubiks-1-N tiers are runs
     of one trial, and a grid of them run in turn kept one worker of two busy
     (measured: 12 one-trial runs with ``--workers 2`` took the 1-worker wall
-    time, BENCHMARKS.md "sweep scaling"). Trials are given out in grid order;
+    time, BENCHMARKS.md "2026-12-03: sweep wall time"). Trials are given out in grid order;
     each depends only on (run, index), so the rows are the same for any
     worker count.
     """
