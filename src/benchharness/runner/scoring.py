@@ -166,6 +166,15 @@ def score_inhand(item: InhandItem, outcome: TrialOutcome) -> Verdict:
         )
     data["metrics"] = {k: _f(v[0]) for k, v in s.values().items()}
     data["discarded"] = bool(s.discarded[0])
+    # The 10 % rule first: a set-up it rejects "must be discarded" whatever the execution did after
+    # it. Checked after the drop, the same rejected set-up (the set-up does not depend on the
+    # method) was stored `dropped` for a method that lost the object and `discarded` for one that
+    # held it (500-execution Table II, PyBullet, trial 29), though Table II excluded it either way.
+    if s.discarded[0]:
+        message = "set-up pose off by more than 10 % (discarded)"
+        if dropped:
+            message += f"; then {outcome.message or 'object dropped'}"
+        return Verdict(TrialStatus.DISCARDED, None, None, message, data)
     if dropped:
         return Verdict(
             TrialStatus.FAILURE,
@@ -173,9 +182,5 @@ def score_inhand(item: InhandItem, outcome: TrialOutcome) -> Verdict:
             FailureCause.DROPPED,
             outcome.message or "object dropped",
             data,
-        )
-    if s.discarded[0]:
-        return Verdict(
-            TrialStatus.DISCARDED, None, None, "set-up pose off by more than 10 % (discarded)", data
         )
     return Verdict(TrialStatus.SUCCESS, _f(s.err_pos[0]), None, outcome.message, data)
