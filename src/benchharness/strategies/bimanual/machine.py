@@ -882,7 +882,8 @@ class BimanualRubiksMachine:
         orientation and the straight way back in (in 2 cm steps) stay clear (where the
         straight way out is not clear, the swing is checked from where the hand is), and
         a ``detour`` event is recorded. If none does, the direct move is made and
-        a warning recorded.
+        a warning recorded, unless its path enters the believed cube or the table from a start
+        outside them: then the trial ends ``unreachable`` (the move would knock the cube).
 
         ``detour``: take the detour even if the direct move clears (a change of arm branch: the
         direct move is a swing of the whole arm, its tracking off the checked joint path; measured,
@@ -967,6 +968,17 @@ class BimanualRubiksMachine:
         if detour and clear >= min(cfg.sweep_clearance, start):  # no detour, but the move clears
             self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
             return
+        if clear <= 0.0 < start:
+            # the straight path enters the believed cube (or the table) and nothing goes round: the
+            # move would knock the cube, so the trial ends here with that cause. Made anyway, it put
+            # the open hand through the cube (measured: SAPIEN Rubiks-5-200 dead reckoning seed 0
+            # trial 2, the hand-over re-grip stand-off; the re-grip then found the cube 31.6 mm and
+            # 19.6 deg off, the twist turned the wrong layer, and the trial ended `dropped`).
+            raise StrategyFailure(
+                "unreachable",
+                f"{hand.side} arm: the move to the {label} passes through the believed cube or the "
+                "table and no detour clears it",
+            )
         self.ctx.recorder.event(
             "warning",
             message=f"{hand.side}: the move to the {label} passes {1000 * clear:.0f} mm from the "
