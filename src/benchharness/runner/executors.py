@@ -31,7 +31,7 @@ from .causes import FailureCause
 from .records import TrialRecord
 from .spec import RunSpec
 from .store import ClaimOwner, ResultsStore
-from .sweep import LEASE_S, SweepReport, _failure_record, _Signals, prepare, run_sweeps
+from .sweep import LEASE_S, SweepReport, _failure_record, _Signals, _start, prepare, run_sweeps
 from .trial import execute_trial
 
 __all__ = ["EXECUTORS", "RAY_MISSING", "loopback_env", "pending_trials", "run_grid"]
@@ -122,15 +122,19 @@ def _run_ray(
         raise ValueError(RAY_MISSING) from None
     if max_retries < 0:
         raise ValueError(f"--max-retries {max_retries}: must be 0 or more")
-    reports: list[SweepReport] = []
-    for spec in specs:  # every name checked before the cluster starts
-        plan = prepare(spec)
-        selected = sorted(plan.items)
-        done = store.finished(spec.run_key, retry_failed=retry_failed)
-        reports.append(
-            SweepReport(spec, plan, selected, skipped=[i for i in selected if i in done])
-        )
     owner = ClaimOwner.new()
+    reports = [  # every name checked before the cluster starts; the pool's own run reports
+        _start(
+            spec,
+            store,
+            owner,
+            trials=None,
+            retry_failed=retry_failed,
+            video=None,
+            wait_for_others=False,
+        ).report
+        for spec in specs
+    ]
     since = time.time()
     started_here = not ray.is_initialized()
     if started_here:

@@ -441,6 +441,7 @@ def _start(
 def _drive(
     runs: list[_Claims],
     store: ResultsStore,
+    owner: ClaimOwner,
     workers: int,
     video: VideoSpec | None,
     on_record: Callable[[TrialRecord], None] | None,
@@ -457,7 +458,6 @@ def _drive(
         if on_record is not None:
             on_record(rec)
 
-    owner = runs[0].owner if runs else ClaimOwner.new()
     with _Signals() as signals, store.keep_claims(owner, LEASE_S):
         if workers > 0:
             ctx = multiprocessing.get_context("spawn")
@@ -494,10 +494,11 @@ def run_sweep(
     only the per-step budget check and the wall alarm apply. Raises
     :class:`SweepInterrupted` on Ctrl-C/SIGTERM once finished trials are stored.
     """
+    owner = ClaimOwner.new()
     claims = _start(
         spec,
         store,
-        ClaimOwner.new(),
+        owner,
         trials=trials,
         retry_failed=retry_failed,
         video=video,
@@ -505,7 +506,7 @@ def run_sweep(
     )
     if on_start is not None:
         on_start(claims.report, len(claims.queue))
-    _drive([claims], store, workers, video, on_record)
+    _drive([claims], store, owner, workers, video, on_record)
     return claims.report
 
 
@@ -540,5 +541,5 @@ def run_sweeps(
         )
         for spec in specs
     ]
-    _drive(runs, store, workers, None, on_record)
+    _drive(runs, store, owner, workers, None, on_record)
     return [claims.report for claims in runs]
