@@ -242,3 +242,29 @@ def test_every_command_has_help_with_an_example(command):
     assert (
         r.exit_code == 0 and "Example:" in r.stdout and f"benchharness rubiks {command}" in r.stdout
     )
+
+
+def test_python_dash_m_runs_the_same_command_line():
+    """``python -m benchharness`` (an interpreter whose ``bin/`` is not on PATH; the sweep bench uses
+    it) is the ``benchharness`` command: same program name, same subcommands, same exit codes."""
+    import subprocess
+    import sys
+
+    from benchharness import __version__
+
+    out = subprocess.run(
+        [sys.executable, "-m", "benchharness", "--version"], capture_output=True, text=True
+    )
+    assert (out.returncode, out.stdout.strip()) == (0, f"benchharness, version {__version__}")
+    usage = subprocess.run(
+        [sys.executable, "-m", "benchharness", "rubiks", "sequence", "--help"],
+        capture_output=True,
+        text=True,
+    )
+    assert usage.stdout.startswith("Usage: benchharness rubiks sequence [OPTIONS]"), usage.stdout
+    bad = subprocess.run(
+        [sys.executable, "-m", "benchharness", "rubiks", "sequence", "--tier", "Rubiks-9-9"],
+        capture_output=True,
+        text=True,
+    )
+    assert bad.returncode == 2 and "unknown tier 'Rubiks-9-9'" in bad.stderr, bad.stderr
