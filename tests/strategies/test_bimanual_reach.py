@@ -281,6 +281,52 @@ def test_handover_turn_brings_a_tilted_believed_cube_back_to_faces_level():
             assert np.array_equal(got.p, want.p) and np.array_equal(got.q, want.q)
 
 
+def test_a_stuck_turn_is_levelled_once_and_only_where_no_turn_is_levelled_already():
+    """``level_stuck_turns`` (HERB's): a giver's choice that found no smooth turn on a believed cube 6.3 deg
+    off faces-level (the belief SAPIEN Rubiks-1-100 seed 0 had at its failed turn) asks for the choice
+    again with that turn levelled: ``turn_path`` then ends faces-level (the offset computed here from the
+    24-rotation group, to 1e-9 rad) and a ``turn_levelled`` event says by how much. It is asked once per
+    hand-over; a faces-level belief, the option off, or every turn levelled already (the PR2's
+    ``recentre_tilt``) leave the turn as it was and say no."""
+    from dataclasses import replace
+
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    def herb(**cfg):
+        m = PushGraspStrategy(replace(HerbPushGraspConfig(), **cfg))
+        m.ctx = SimpleNamespace(recorder=_Rec())
+        return m
+
+    belief = Rotation.from_quat([-0.69983, -0.03688, -0.71226, -0.03947])
+    assert np.degrees(_faces_level_offset(belief)) == pytest.approx(6.27, abs=0.01)
+    twist = np.asarray(HerbPushGraspConfig().twist_position)
+    est = Pose.from_rotation(twist + [0.0, 0.0032, -0.0004], belief)
+    grip = est * Pose.from_rotation([0.0, 0.0, 0.087], Rotation.from_euler("y", 180, degrees=True))
+    in_grip = grip.inv() * est
+    hand = SimpleNamespace(side="left")
+
+    m = herb()
+    assert m.config.level_stuck_turns and not m.config.recentre_tilt
+    m.est = est
+    assert not np.any(m.turn_path("z", math.pi / 2).level)  # not levelled before it is asked
+    assert m.level_stuck_turn(hand)
+    assert m.ctx.recorder.events == [("turn_levelled", {"hand": "left", "tilt_deg": 6.27})]
+    end = m.turn_path("z", math.pi / 2).at(grip, 4, 4) * in_grip
+    assert _faces_level_offset(end.rotation) < 1e-9
+    assert not m.level_stuck_turn(hand)  # once a hand-over
+    assert len(m.ctx.recorder.events) == 1
+
+    for mm, e in (
+        (herb(), Pose.from_rotation(est.p, Rotation.from_euler("z", -90, degrees=True))),
+        (herb(level_stuck_turns=False), est),
+        (herb(recentre_tilt=True), est),
+    ):
+        mm.est = e
+        assert not mm.level_stuck_turn(hand)
+        assert not mm.level_turn and mm.ctx.recorder.events == []
+
+
 #: the inputs of one checked swing, recorded (PyBullet Rubiks-5-5 seed 0 trial 3, t = 244.47 s, at 152efdd:
 #: the right hand's hand-over re-grip): the arm's joints, its commanded tool pose, the stand-off, the
 #: believed cube, the arm's base (world) and the trial's injected calibration of that arm (SAPIEN's trial 3

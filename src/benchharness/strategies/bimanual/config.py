@@ -134,6 +134,15 @@ class BimanualConfig:
     #: faces-level by twist 33 of PyBullet Rubiks-1-50 (PR2, sensor-aided seed 0), and the grips' stand-offs
     #: tilt with it out of the arm's reach. False: the turn keeps the orientation's drift.
     recentre_tilt: bool = False
+    #: with ``recentre_tilt`` off, a giver's grip choice that finds no grip whose hand-over turn is smooth
+    #: (from the arm's branch or from a posture found backwards) tries again with this one turn levelled
+    #: (:meth:`.machine.BimanualRubiksMachine.level_stuck_turn`), before taking the least bad grip. Why:
+    #: a believed cube 6.3 deg off faces-level left the left WAM no smooth +90 deg turn about z at the twist
+    #: position (0 of 64 backward chains, 42 of 64 with the turn levelled; ``bench/scan_herb_twist_position.py``),
+    #: the least bad grip's turn ended 16.6 mm from its target and HERB's SAPIEN Rubiks-1-100 seed 0 ended
+    #: ``unreachable`` after 3 moves. Only a turn that had no smooth grip changes: every other trial is as
+    #: without it (``recentre_tilt`` for every turn changed them all, docs/herb_push_grasp.md).
+    level_stuck_turns: bool = False
     #: waypoints per quarter turn when the giver turns the cube in a hand-over.
     handover_waypoints: int = 4
     #: the hand that is about to hold the cube alone (the picker, a hand-over's taker) grips two slabs deep

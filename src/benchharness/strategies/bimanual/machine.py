@@ -263,6 +263,9 @@ class BimanualRubiksMachine:
 
     def __init__(self, grasp: GraspModule) -> None:
         self.grasp = grasp
+        #: the hand-over turn being planned is levelled although ``recentre_tilt`` is off
+        #: (:meth:`level_stuck_turn`); cleared when the hand-over's turn is made
+        self.level_turn = False
 
     @property
     def config(self) -> BimanualConfig:
@@ -359,6 +362,7 @@ class BimanualRubiksMachine:
         self.plan: RegraspPlan = plan
         self.trace = trace
         self.t_release: float | None = None
+        self.level_turn = False
         #: the plan's move the latest twist made (0 before the first): the x of pose-estimate records
         self.move_index = 0
         try:
@@ -577,7 +581,8 @@ class BimanualRubiksMachine:
     def turn_path(self, axis: str, angle: float) -> TurnPath:
         """The hand-over turn of the cube as believed now: ``angle`` rad about world ``axis`` through the
         believed centre; with ``recentre_turn`` the centre is also carried back to ``twist_position``, with
-        ``recentre_tilt`` the turned orientation is also brought to the nearest faces-level one.
+        ``recentre_tilt`` (or for this hand-over, :meth:`level_stuck_turn`) the turned orientation is
+        also brought to the nearest faces-level one.
 
         The level correction is computed for the orientation before the turn and carried through it (the
         turn by a multiple of 90 degrees about a world axis maps faces-level orientations onto each other,
@@ -594,11 +599,28 @@ class BimanualRubiksMachine:
             else np.zeros(3)
         )
         level = np.zeros(3)
-        if cfg.recentre_tilt:
+        if cfg.recentre_tilt or self.level_turn:
             v = level_correction(self.est.rotation)
             if np.any(v):
                 level = Rotation.from_rotvec(DIRECTIONS[axis] * angle).apply(v)
         return TurnPath(self.est.p.copy(), axis, angle, shift, level)
+
+    def level_stuck_turn(self, hand: Hand) -> bool:
+        """Level this hand-over's turn (``level_stuck_turns``), for a giver's grip choice that found no
+        grip whose turn is smooth: True if the choice should be made again with the turn levelled
+        (the option is on, the turns are not levelled already and the belief is off faces-level by
+        more than 0.1 deg); records a ``turn_levelled`` event."""
+        cfg = self.config
+        if not cfg.level_stuck_turns or cfg.recentre_tilt or self.level_turn:
+            return False
+        tilt = float(np.linalg.norm(level_correction(self.est.rotation)))
+        if tilt < math.radians(0.1):
+            return False
+        self.level_turn = True
+        self.ctx.recorder.event(
+            "turn_levelled", hand=hand.side, tilt_deg=round(math.degrees(tilt), 2)
+        )
+        return True
 
     def turn_travel(
         self,
@@ -1700,6 +1722,7 @@ class BimanualRubiksMachine:
                 settle=0.05 if i < n else 0.2,
             )
         self._judge("hand-over turned", giver)
+        self.level_turn = False
         # The taker holds the cube alone while the giver comes round: with ``lone_holder_two_slabs``
         # two slabs deep, whichever hand rotates next (a one-slab grip let the cube pivot about its
         # pad axis: measured on PyBullet, 32 degrees as the giver let go); if the taker is then the

@@ -145,6 +145,10 @@ class HerbPushGraspConfig(BimanualConfig):
     #: Rubiks-1-20's first 10 moves the cube wandered from (0.900, 0, 1.100) to (0.907, 0, 1.086) m and the
     #: 11th hand-over turn's IK ended 6.9 mm off (PyBullet, seed 0).
     recentre_turn: bool = True
+    #: a giver that finds no grip with a smooth hand-over turn chooses again with that turn levelled (the
+    #: machine's ``level_stuck_turns``; ``recentre_tilt`` stays off: levelling every turn changed every trial
+    #: and, measured on this VM, did not complete more of Rubiks-1-20 or Rubiks-5-5, docs/herb_push_grasp.md).
+    level_stuck_turns: bool = True
     #: when no giver grip solved from the arm's joints has a smooth hand-over turn: starts per finger
     #: placement, drawn over the whole joint range, from which the turn and the giver's retreat are solved
     #: backwards (:meth:`..bimanual.machine.BimanualRubiksMachine.turn_postures`, the PR2's value). The IK

@@ -313,6 +313,9 @@ class PushGrasp:
             if found is not None:
                 best, best_slide, best_q = found
                 tried.append("a posture found backwards from the retreat's end (giver_posture)")
+        if best is None and second is None and turn is not None and m.level_stuck_turn(hand):
+            # no grip has a smooth turn on the believed tilt: choose again with the turn levelled
+            return self.choose(m, hand, req)
         if best is None and second is not None:
             m.ctx.recorder.event(
                 "warning",
