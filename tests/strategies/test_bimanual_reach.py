@@ -22,12 +22,15 @@ class _Rec:
 
 
 @pytest.mark.sim
-def test_send_out_of_reach_fails_without_moving_the_arm(make_ctx):
+@pytest.mark.parametrize("skip", [False, True], ids=["fails", "skipped"])
+def test_send_out_of_reach_fails_without_moving_the_arm(make_ctx, skip):
     """The PR2's left arm nearly straight (elbow flex 10 mrad from its limit), sent 2 mm farther out from
     the shoulder than its tool frame is: no IK solution. The IK's best attempt is a restart on another
     branch (the upper-arm and forearm rolls ~2.7 rad away, as measured in SAPIEN Rubiks-5-20 trial 5),
     to which the arm used to move before the failure was raised; now the send fails `unreachable`, the
-    joints and the forward kinematics' tool frame stay where they were and the command is not taken."""
+    joints and the forward kinematics' tool frame stay where they were and the command is not taken.
+    With ``skip_unreached`` (a swing's arc waypoint, which the swing leaves out) the send returns False
+    instead of failing, and likewise moves nothing."""
     from benchharness.strategies.bimanual.machine import Hand, StrategyFailure
     from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
     from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
@@ -60,9 +63,12 @@ def test_send_out_of_reach_fails_without_moving_the_arm(make_ctx):
     res = arm.ik((arm.base_pose().inv() * target).as_matrix()[None], seed_q=q_before)
     assert not res.success[0]
     assert np.max(np.abs(res.q[0] - q_before)) > 2.0
-    with pytest.raises(StrategyFailure, match="not moved") as err:
-        m.send(hand, target, label="test")
-    assert err.value.cause == "unreachable"
+    if skip:
+        assert m.send(hand, target, label="test", skip_unreached=True) is False
+    else:
+        with pytest.raises(StrategyFailure, match="not moved") as err:
+            m.send(hand, target, label="test")
+        assert err.value.cause == "unreachable"
     assert np.max(np.abs(arm.positions() - q_before)) < 0.01
     fk = arm.base_pose() * Pose.from_matrix(arm.chain.fk(arm.positions()[None])[0])
     assert np.linalg.norm(fk.p - tcp.p) < 2e-3
