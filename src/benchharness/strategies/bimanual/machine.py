@@ -909,6 +909,7 @@ class BimanualRubiksMachine:
         label: str,
         seed_q: np.ndarray | None = None,
         detour: bool = False,
+        settle: float = 0.05,
     ) -> None:
         """Move a free hand to the stand-off ``target`` without sweeping it through the cube.
 
@@ -928,17 +929,19 @@ class BimanualRubiksMachine:
         direct move is a swing of the whole arm, its tracking off the checked joint path; measured,
         PyBullet Rubiks-1-5 dead-reckoning-exact seed 0: a 3.7 rad stand-off move checked 23 mm
         clear put the palm on the cube at 52 N and turned it 18 deg).
+
+        ``settle``: how long the arm settles at ``target`` (s).
         """
         cfg = self.config
         points = self._hand_points()
         if points is None:
-            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
         q0 = hand.arm.positions()
         plan_seed = q0 if seed_q is None else seed_q
         q1 = self.ik_q(hand, target, plan_seed)
         if q1 is None or (not detour and self._clears(hand, q0, q1, points)):
-            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
         clear = self.sweep_clearance(hand, q0, q1, points)
         c = self.est.p
@@ -999,13 +1002,13 @@ class BimanualRubiksMachine:
                     hand,
                     way,
                     label=label if last else f"{label} detour in",
-                    settle=0.05 if last else 0.02,
+                    settle=settle if last else 0.02,
                     seed_q=q,
                 )
             return
         start = self.sweep_clearance(hand, q0, q0, points, n=1)
         if detour and clear >= min(cfg.sweep_clearance, start):  # no detour, but the move clears
-            self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+            self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
         if clear <= 0.0 < start:
             # the straight path enters the believed cube (or the table) and nothing goes round: the
@@ -1023,7 +1026,7 @@ class BimanualRubiksMachine:
             message=f"{hand.side}: the move to the {label} passes {1000 * clear:.0f} mm from the "
             f"cube and no detour clears it",
         )
-        self.send(hand, target, label=label, settle=0.05, seed_q=seed_q)
+        self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
 
     def _arc(self, c: np.ndarray, dirs: list, quats: list, r0: float, r1: float) -> list[Pose]:
         """Waypoints (tool poses, the ends left out) on great-circle legs about ``c`` through the unit
