@@ -950,70 +950,52 @@ class BimanualRubiksMachine:
         for d in cfg.detour_distances:
             out = self.back_off(hand.cmd, max(0.0, d - r0))
             turned = self.back_off(target, max(0.0, d - r1))
-            leg_out = self._line(hand, hand.cmd, out, q0, points)
-            if leg_out is None:
-                # no straight way out (a joint limit on it): the joint-space turn to the stand-off's
-                # orientation from here, if that alone is clear (measured: a giver that had slid out
-                # sideways beside the cube, its shoulder pan and upper-arm roll on their soft limits,
-                # SAPIEN Rubiks-1-20 sensor-aided seed 0)
-                leg_out = []
-            qa = leg_out[-1][1] if leg_out else q0
-            qb = self.ik_q(hand, turned, plan_seed)
-            if qb is None or not self._clears(hand, qa, qb, points):
-                continue
-            leg_in = self._line(hand, turned, target, qb, points)
-            if leg_in is None:
-                continue
-            self.ctx.recorder.event(
-                "detour",
-                hand=hand.side,
-                label=label,
-                clearance_mm=round(1000 * clear, 1),
-                distance_m=d,
-                straight_out=bool(leg_out),
-                **({"branch_change": True} if detour else {}),
-            )
-            # the way out and the turn are via points in free space, moving away from the cube: they
-            # were solved for the believed pose; the injected calibration can put the arm's target just
-            # out of reach (measured: 11.7 mm short at 25 cm, PyBullet Rubiks-1-20 sensor-aided seed 0;
-            # a way-out step 0.9 mm short, seeded on its planned chain, once an unconverged move was no
-            # longer made, PyBullet Rubiks-1-20 at 66b020b), which within ``sweep_clearance`` leaves the
-            # detour's clearance argument intact
-            for way, q in leg_out:
-                self.send(
-                    hand,
-                    way,
-                    label=f"{label} detour out",
-                    settle=0.02,
-                    seed_q=q,
-                    slack=cfg.sweep_clearance,
-                )
-            self.send(
+            if self._detour(
                 hand,
+                target,
+                out,
                 turned,
-                label=f"{label} detour turn",
-                settle=0.02,
-                seed_q=qb,
-                slack=cfg.sweep_clearance,
-            )
-            for k, (way, q) in enumerate(leg_in):
-                last = k == len(leg_in) - 1
-                self.send(
-                    hand,
-                    way,
-                    label=label if last else f"{label} detour in",
-                    settle=settle if last else 0.02,
-                    seed_q=q,
-                )
-            return
+                q0,
+                plan_seed,
+                points,
+                label,
+                settle,
+                clear=clear,
+                distance=d,
+                branch_change=detour,
+            ):
+                return
         start = self.sweep_clearance(hand, q0, q0, points, n=1)
         if detour and clear >= min(cfg.sweep_clearance, start):  # no detour, but the move clears
             self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
         if clear <= 0.0 < start:
-            # the straight path enters the believed cube (or the table) and nothing goes round: the
-            # move would knock the cube, so the trial ends here with that cause. Made anyway, it put
-            # the open hand through the cube (measured: SAPIEN Rubiks-5-200 dead reckoning seed 0
+            # the straight path enters the believed cube (or the table) and no detour out along the
+            # approach goes round: the way out straight up instead (measured: PyBullet Rubiks-5-10
+            # sensor-aided seed 0 trial 3, a giver that had retreated sideways in front of the cube, its
+            # wrist flex on its soft limit, had no straight way back along its approach; 10 cm up, the
+            # turn and the way in all clear; it ended `unreachable` here before)
+            for d in cfg.detour_distances:
+                up = Pose(hand.cmd.p + np.array([0.0, 0.0, max(0.0, d - r0)]), hand.cmd.q)
+                turned = self.back_off(target, max(0.0, d - r1))
+                if self._detour(
+                    hand,
+                    target,
+                    up,
+                    turned,
+                    q0,
+                    plan_seed,
+                    points,
+                    label,
+                    settle,
+                    clear=clear,
+                    distance=d,
+                    way_out="up",
+                ):
+                    return
+            # nothing goes round: the move would knock the cube, so the trial ends here with that
+            # cause. Made anyway, it put the open hand through the cube (measured: SAPIEN Rubiks-5-200
+            # dead reckoning seed 0
             # trial 2, the hand-over re-grip stand-off; the re-grip then found the cube 31.6 mm and
             # 19.6 deg off, the twist turned the wrong layer, and the trial ended `dropped`).
             raise StrategyFailure(
@@ -1027,6 +1009,90 @@ class BimanualRubiksMachine:
             f"cube and no detour clears it",
         )
         self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
+
+    def _detour(
+        self,
+        hand: Hand,
+        target: Pose,
+        out: Pose,
+        turned: Pose,
+        q0: np.ndarray,
+        plan_seed: np.ndarray,
+        points: np.ndarray,
+        label: str,
+        settle: float,
+        *,
+        clear: float,
+        distance: float,
+        branch_change: bool = False,
+        way_out: str | None = None,
+    ) -> bool:
+        """One detour of :meth:`transit`, made if every leg is clear: straight out from the command to
+        ``out``, a joint-space turn to ``turned`` (the target backed off along its approach), straight in
+        to ``target``; False (nothing moved) if a leg is not clear. ``clear`` (the direct move's clearance)
+        and ``distance`` are recorded in the ``detour`` event. The way out along the approach
+        (``way_out`` None) that is not clear is left out and the turn is checked from where the hand
+        is; another way out (``way_out`` names it in the event) must be clear."""
+        cfg = self.config
+        leg_out = self._line(hand, hand.cmd, out, q0, points)
+        if leg_out is None:
+            if way_out is not None:
+                return False
+            # no straight way out (a joint limit on it): the joint-space turn to the stand-off's
+            # orientation from here, if that alone is clear (measured: a giver that had slid out
+            # sideways beside the cube, its shoulder pan and upper-arm roll on their soft limits,
+            # SAPIEN Rubiks-1-20 sensor-aided seed 0)
+            leg_out = []
+        qa = leg_out[-1][1] if leg_out else q0
+        qb = self.ik_q(hand, turned, plan_seed)
+        if qb is None or not self._clears(hand, qa, qb, points):
+            return False
+        leg_in = self._line(hand, turned, target, qb, points)
+        if leg_in is None:
+            return False
+        self.ctx.recorder.event(
+            "detour",
+            hand=hand.side,
+            label=label,
+            clearance_mm=round(1000 * clear, 1),
+            distance_m=distance,
+            straight_out=bool(leg_out),
+            **({"branch_change": True} if branch_change else {}),
+            **({"way_out": way_out} if way_out is not None else {}),
+        )
+        # the way out and the turn are via points in free space, moving away from the cube: they
+        # were solved for the believed pose; the injected calibration can put the arm's target just
+        # out of reach (measured: 11.7 mm short at 25 cm, PyBullet Rubiks-1-20 sensor-aided seed 0;
+        # a way-out step 0.9 mm short, seeded on its planned chain, once an unconverged move was no
+        # longer made, PyBullet Rubiks-1-20 at 66b020b), which within ``sweep_clearance`` leaves the
+        # detour's clearance argument intact
+        for way, q in leg_out:
+            self.send(
+                hand,
+                way,
+                label=f"{label} detour out",
+                settle=0.02,
+                seed_q=q,
+                slack=cfg.sweep_clearance,
+            )
+        self.send(
+            hand,
+            turned,
+            label=f"{label} detour turn",
+            settle=0.02,
+            seed_q=qb,
+            slack=cfg.sweep_clearance,
+        )
+        for k, (way, q) in enumerate(leg_in):
+            last = k == len(leg_in) - 1
+            self.send(
+                hand,
+                way,
+                label=label if last else f"{label} detour in",
+                settle=settle if last else 0.02,
+                seed_q=q,
+            )
+        return True
 
     def _arc(self, c: np.ndarray, dirs: list, quats: list, r0: float, r1: float) -> list[Pose]:
         """Waypoints (tool poses, the ends left out) on great-circle legs about ``c`` through the unit
