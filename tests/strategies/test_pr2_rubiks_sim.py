@@ -388,34 +388,43 @@ def test_sensor_aided_rubiks_1_10_on_pybullet_skips_a_waypoint_and_detours_back_
 
 
 @pytest.mark.slow
-def test_a_detour_goes_up_where_the_way_back_along_the_approach_is_blocked(tmp_path):
-    """PyBullet Rubiks-5-10 sensor-aided seed 0, trial 3 (~60 CPU-s). At 264.8 s the right hand, a giver
-    that had retreated sideways in front of the cube with its wrist flex on its soft limit, had to reach
-    its re-grip stand-off beside the cube: the direct joint path passes through the believed cube and no
-    straight way back along its approach exists, so the trial ended `unreachable`. The way out straight
-    up (10-15 cm), the turn and the way in are clear: the hand now takes that detour (a ``detour`` event
-    with ``way_out`` "up") and the trial completes. Intel platform only, as the test above."""
+@pytest.mark.parametrize(
+    ("task", "backend", "t", "hand", "way_out", "score"),
+    [
+        ("Rubiks-5-10", "pybullet", 264.8, "right", "up", 343.138),
+        ("Rubiks-5-100", "sapien", 588.1, "left", "side", 2910.354),
+    ],
+    ids=["up", "side"],
+)
+def test_a_detour_goes_up_or_aside_where_the_way_back_along_the_approach_is_blocked(
+    tmp_path, task, backend, t, hand, way_out, score
+):
+    """Sensor-aided seed 0, trial 3 of PyBullet Rubiks-5-10 (~60 CPU-s) and of SAPIEN Rubiks-5-100 (~4.5
+    CPU-min). At ``t`` a free hand in front of the cube had to reach its re-grip stand-off beside it:
+    the direct joint path passes through the believed cube and no detour out along its approach clears
+    (PyBullet: a giver retreated sideways with its wrist flex on its soft limit), so the trial ended
+    `unreachable`. The way out straight up (PyBullet) or towards the stand-off's side (SAPIEN), the
+    turn and the way in are clear: the hand takes that detour (a ``detour`` event with ``way_out``) and
+    the trial completes. Intel platform only, as the test above."""
     intel = [k for k in REFERENCE_ROWS if k.startswith("Intel(R) Xeon(R) Processor")]
     if platform_key() not in intel:
         pytest.skip(f"measured on {intel[0]!r}")
     import sqlite3
 
     store = tmp_path / "runs.sqlite"
-    cmd = [sys.executable, "-m", "benchharness.cli.main", "run", "--task", "Rubiks-5-10"]
-    cmd += ["--robot", "pr2", "--strategy", "sensor-aided", "--backend", "pybullet", "--seed", "0"]
-    cmd += ["--trials", "3", "--workers", "0", "--store", str(store)]
+    cmd = [sys.executable, "-m", "benchharness.cli.main", "run", "--task", task, "--robot", "pr2"]
+    cmd += ["--strategy", "sensor-aided", "--backend", backend, "--seed", "0", "--trials", "3"]
+    cmd += ["--workers", "0", "--store", str(store)]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=1800)
     rows = sqlite3.connect(store).execute(
         "select status, failure_cause, message, score, diagnostics_json from trials"
     )
     rows = rows.fetchall()
     assert len(rows) == 1, proc.stderr[-2000:]
-    status, cause, message, score, diag = rows[0]
-    ups = [
-        e for e in json.loads(diag)["events"] if e["kind"] == "detour" and e.get("way_out") == "up"
-    ]
-    assert [(round(e["t"], 1), e["hand"], e["label"]) for e in ups] == [
-        (264.8, "right", "hand-over re-grip stand-off")
+    status, cause, message, got, diag = rows[0]
+    ways = [e for e in json.loads(diag)["events"] if e["kind"] == "detour" and "way_out" in e]
+    assert [(round(e["t"], 1), e["hand"], e["label"], e["way_out"]) for e in ways] == [
+        (t, hand, "hand-over re-grip stand-off", way_out)
     ]
     assert status == "success", (status, cause, message)
-    assert score == pytest.approx(343.138, abs=1e-3)
+    assert got == pytest.approx(score, abs=1e-3)

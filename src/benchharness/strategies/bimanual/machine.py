@@ -971,28 +971,36 @@ class BimanualRubiksMachine:
             return
         if clear <= 0.0 < start:
             # the straight path enters the believed cube (or the table) and no detour out along the
-            # approach goes round: the way out straight up instead (measured: PyBullet Rubiks-5-10
-            # sensor-aided seed 0 trial 3, a giver that had retreated sideways in front of the cube, its
-            # wrist flex on its soft limit, had no straight way back along its approach; 10 cm up, the
-            # turn and the way in all clear; it ended `unreachable` here before)
-            for d in cfg.detour_distances:
-                up = Pose(hand.cmd.p + np.array([0.0, 0.0, max(0.0, d - r0)]), hand.cmd.q)
-                turned = self.back_off(target, max(0.0, d - r1))
-                if self._detour(
-                    hand,
-                    target,
-                    up,
-                    turned,
-                    q0,
-                    plan_seed,
-                    points,
-                    label,
-                    settle,
-                    clear=clear,
-                    distance=d,
-                    way_out="up",
-                ):
-                    return
+            # approach goes round: the way out straight up, then towards the stand-off's side of the
+            # cube (measured: PyBullet Rubiks-5-10 sensor-aided seed 0 trial 3, a giver that had
+            # retreated sideways in front of the cube, its wrist flex on its soft limit, had no straight
+            # way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
+            # Rubiks-5-100 trial 3, a hand 13 cm in front of the cube going to a stand-off on its left:
+            # only the way out 10-15 cm to the left clears. Both ended `unreachable` here before)
+            side = target.p - c
+            ways = [
+                ("up", np.array([0.0, 0.0, 1.0])),
+                ("side", side / max(np.linalg.norm(side), 1e-9)),
+            ]
+            for name, direction in ways:
+                for d in cfg.detour_distances:
+                    way = Pose(hand.cmd.p + max(0.0, d - r0) * direction, hand.cmd.q)
+                    turned = self.back_off(target, max(0.0, d - r1))
+                    if self._detour(
+                        hand,
+                        target,
+                        way,
+                        turned,
+                        q0,
+                        plan_seed,
+                        points,
+                        label,
+                        settle,
+                        clear=clear,
+                        distance=d,
+                        way_out=name,
+                    ):
+                        return
             # nothing goes round: the move would knock the cube, so the trial ends here with that
             # cause. Made anyway, it put the open hand through the cube (measured: SAPIEN Rubiks-5-200
             # dead reckoning seed 0
