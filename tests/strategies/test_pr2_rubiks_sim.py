@@ -428,3 +428,43 @@ def test_a_detour_goes_up_or_aside_where_the_way_back_along_the_approach_is_bloc
     ]
     assert status == "success", (status, cause, message)
     assert got == pytest.approx(score, abs=1e-3)
+
+
+#: Issue 16's targets for sensor-aided (seed 0): the paper's PR2 completed Rubiks-1-50 (1123.04 s),
+#: Rubiks-1-100 (2207.97 s) and Rubiks-5-20 (416.61 ± 23.10 s) with pre-touch sensing (Table I of the
+#: Rubik's benchmark paper); ours must complete them on both engines. Where a platform is known not to,
+#: the reason it does not (traced) is kept here and the case is a strict xfail there.
+KNOWN_MISSES = {
+    ("Rubiks-1-100", "pybullet", "Intel(R) Xeon(R) Processor"): (
+        "after the 29th hand-over the free arm's elbow pushes the holding arm 27 mm (the arms are "
+        "checked against each other only at a grip's posture; BENCHMARKS.md, 2026-12-03 'evening')"
+    ),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("task", ("Rubiks-1-50", "Rubiks-1-100", "Rubiks-5-20"))
+def test_sensor_aided_completes_the_tiers_the_papers_pr2_completed(tmp_path, task, backend):
+    """Every trial of the tier ends in the expected state with every twist as intended (1-50 ~3-5
+    CPU-min, 1-100 ~5-9, 5-20 ~5-7 per engine)."""
+    key = platform_key()
+    known = next(
+        (
+            why
+            for (t, b, cpu), why in KNOWN_MISSES.items()
+            if (t, b) == (task, backend) and key.startswith(cpu)
+        ),
+        None,
+    )
+    proc, rows = _run_cli(tmp_path, "sensor-aided", backend, task=task)
+    n_trials = int(task.split("-")[1])
+    assert len(rows) == n_trials, proc.stderr[-2000:]
+    ok = all(status == "success" for status, *_ in rows)
+    if known is not None:
+        assert not ok, f"{task} on {backend} now completes here: remove it from KNOWN_MISSES"
+        pytest.xfail(known)
+    for status, cause, message, _score, _sim_s, diag in rows:
+        assert status == "success", (cause, message)
+        moves = [e for e in json.loads(diag)["events"] if e["kind"] == "move"]
+        assert len(moves) == int(task.split("-")[2]) and all(e["as_intended"] for e in moves)
