@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["UrdfJoint", "read_joints", "read_links"]
+__all__ = ["UrdfJoint", "read_joints", "read_links", "read_parents"]
 
 MOVABLE = ("revolute", "prismatic", "continuous")
 
@@ -76,3 +76,11 @@ def read_joints(urdf: str | Path) -> list[UrdfJoint]:
 
 def read_links(urdf: str | Path) -> list[str]:
     return [lk.get("name") for lk in ET.parse(str(urdf)).getroot().findall("link")]
+
+
+def read_parents(urdf: str | Path) -> dict[str, str]:
+    """Each link's parent link, over every joint (fixed ones too): the URDF's link tree."""
+    root = ET.parse(str(urdf)).getroot()
+    return {
+        j.find("child").get("link"): j.find("parent").get("link") for j in root.findall("joint")
+    }

@@ -17,7 +17,7 @@ import numpy as np
 from ..backends.interface import Backend, BodyId
 from ..geometry import Pose
 from .config import RobotConfig
-from .description import UrdfJoint, read_joints, read_links
+from .description import UrdfJoint, read_joints, read_links, read_parents
 from .gravity import GravityModel
 from .kinematics import IKConfig
 from .parts import Gripper, RobotArm
@@ -91,6 +91,20 @@ class Robot:
         return self.grippers[name]
 
     hand = gripper
+
+    def links_below(self, joint: str) -> frozenset[str]:
+        """The links ``joint`` moves: its child link and every link downstream of it (fixed joints
+        included), e.g. an arm's links and its hand's from the arm's first joint."""
+        parents = read_parents(self.urdf_path)
+        top = self.urdf_joints[joint].child
+        out = set()
+        for link in parents.keys() | {top}:
+            x: str | None = link
+            while x is not None and x != top:
+                x = parents.get(x)
+            if x == top:
+                out.add(link)
+        return frozenset(out)
 
     def tcp_links(self) -> dict[str, str]:
         out = {a.name: a.config.tcp_link for a in self.arms.values()}

@@ -58,6 +58,14 @@ class BimanualConfig:
     #: stand-off would sweep the cube makes that move instead: straight back along its own approach to
     #: the distance, there to the stand-off's orientation (the joint-space swing), then straight in.
     detour_distances: tuple[float, ...] = (0.25, 0.35, 0.45)
+    #: after every arm move the engine's contacts between the two arms (each arm's links and its hand's)
+    #: are summed, and a summed normal force of at least this (N) is recorded as an ``arm_contact`` event
+    #: (the hand that moved, the move's label, the force, the pair of links pressing hardest). Record
+    #: only: nothing is planned from it. Why: the arms are checked against each other only at a grip's
+    #: posture, and an elbow pressing on the holding arm moved the cube 27 mm without the belief knowing
+    #: (PyBullet Rubiks-1-100 sensor-aided seed 0, Intel VM: 63-160 N, found by a separate trace). None: no
+    #: check.
+    arm_contact_event: float | None = 5.0
     #: a grip's stand-off and every step of a retreat must stay reachable (IK) with the target moved this
     #: many standard deviations of the injected per-motion position error (calibration and tracking,
     #: ``errors``) either way along each world axis, and turned as many of the calibration's rotation std

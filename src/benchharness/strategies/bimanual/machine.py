@@ -30,7 +30,7 @@ from typing import Any, ClassVar, Protocol
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ...backends.interface import Box, CameraSpec
+from ...backends.interface import Backend, BodyId, Box, CameraSpec
 from ...geometry import Pose
 from ...runner.contract import RubiksItem, TrialContext, TrialOutcome
 from ..regrasp import (
@@ -245,6 +245,23 @@ class GraspModule(Protocol):
         ...
 
 
+def arm_contact_forces(
+    backend: Backend, body: BodyId, left: frozenset[str], right: frozenset[str]
+) -> dict[tuple[str, str], float]:
+    """Summed normal force (N) per pair of links (one of ``left``, one of ``right``) of the robot
+    ``body`` pressing on each other after the last step, from the engine's contacts."""
+    out: dict[tuple[str, str], float] = {}
+    for c in backend.contacts(body, body):
+        a, b = c.link_a, c.link_b
+        if a in right and b in left:
+            a, b = b, a
+        elif not (a in left and b in right):
+            continue
+        key = (str(a), str(b))
+        out[key] = out.get(key, 0.0) + c.normal_force
+    return out
+
+
 def _box_gap(local: np.ndarray, half: np.ndarray | float) -> float:
     """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
     return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=1)))
@@ -343,6 +360,10 @@ class BimanualRubiksMachine:
                 state=self.grasp.hand_state(),
             )
         self.robot.settle(0.2)
+        #: each arm's links and its hand's (``arm_contact_event``)
+        self.arm_links = {
+            side: self.robot.links_below(h.arm.joints[0]) for side, h in self.hands.items()
+        }
         rec.watch_contact(self.cube.body, self.robot.body)
         self.est = self._camera_estimate(ctx)
         rec.pose_estimate(0, self.cube.pose(), self.est, label="camera")
@@ -558,7 +579,28 @@ class BimanualRubiksMachine:
             )
         if hand.holding and not self.other(hand).holding and hand.cube_in_tcp is not None:
             self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
+        self._arm_contact(hand, label)
         return True
+
+    def _arm_contact(self, hand: Hand, label: str) -> None:
+        """An ``arm_contact`` event where the arms press on each other after ``hand``'s move to
+        ``label`` (``arm_contact_event``; record only)."""
+        least = self.config.arm_contact_event
+        if least is None:
+            return
+        forces = arm_contact_forces(
+            self.b, self.robot.body, self.arm_links["left"], self.arm_links["right"]
+        )
+        total = sum(forces.values())
+        if total >= least:
+            links = max(forces, key=lambda k: forces[k])
+            self.ctx.recorder.event(
+                "arm_contact",
+                hand=hand.side,
+                label=label,
+                force_n=round(total, 1),
+                links=list(links),
+            )
 
     def other(self, hand: Hand) -> Hand:
         return self.hands["right" if hand.side == "left" else "left"]
