@@ -103,6 +103,18 @@ def test_results_lists_failures_with_causes(invoke):
     )
 
 
+def test_results_json_counts_each_kind_of_event_the_store_holds(invoke, store_path):
+    import sqlite3
+    from collections import Counter
+
+    invoke(run, "--task", "Rubiks-1-10", "--strategy", "test-drop", *BASE)
+    data = _json(invoke(results, "--json"))["trials"]
+    stored = sqlite3.connect(store_path).execute("select trial_index, diagnostics_json from trials")
+    want = {i: dict(Counter(e["kind"] for e in json.loads(d)["events"])) for i, d in stored}
+    assert want and {t["trial"]: t["event_counts"] for t in data} == want
+    assert any(want.values())  # the trial recorded events of some kind
+
+
 def test_pose_error_plot(invoke, tmp_path):
     invoke(run, "--task", "Rubiks-1-10", "--strategy", "test-drop", *BASE)
     png = tmp_path / "drift.png"

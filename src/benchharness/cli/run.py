@@ -988,6 +988,10 @@ def results(
             if show_tb:
                 d["traceback"] = t.traceback
             d["diagnostics_counts"] = t.diagnostics.get("counts", {})
+            # every kind of event the trial recorded (detour, arm_contact, warning, ...), counted here
+            # from the stored events: the stored counts above hold only the scoring's own
+            kinds = [e.get("kind") for e in t.diagnostics.get("events", [])]
+            d["event_counts"] = {k: kinds.count(k) for k in sorted(set(kinds), key=str)}
             data.append(d)
         emit_json(
             {"trials": data, "plot": plotted, "plot_off_scale": [o.to_dict() for o in off_scale]}
