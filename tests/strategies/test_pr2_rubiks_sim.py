@@ -457,9 +457,11 @@ def test_sensor_aided_completes_the_tiers_the_papers_pr2_completed(tmp_path, tas
         ),
         None,
     )
+    from benchharness.cube.tiers import get_tier
+
+    tier = get_tier(task)
     proc, rows = _run_cli(tmp_path, "sensor-aided", backend, task=task)
-    n_trials = int(task.split("-")[1])
-    assert len(rows) == n_trials, proc.stderr[-2000:]
+    assert len(rows) == tier.trials, proc.stderr[-2000:]
     ok = all(status == "success" for status, *_ in rows)
     if known is not None:
         assert not ok, f"{task} on {backend} now completes here: remove it from KNOWN_MISSES"
@@ -467,4 +469,4 @@ def test_sensor_aided_completes_the_tiers_the_papers_pr2_completed(tmp_path, tas
     for status, cause, message, _score, _sim_s, diag in rows:
         assert status == "success", (cause, message)
         moves = [e for e in json.loads(diag)["events"] if e["kind"] == "move"]
-        assert len(moves) == int(task.split("-")[2]) and all(e["as_intended"] for e in moves)
+        assert len(moves) == tier.moves and all(e["as_intended"] for e in moves)

@@ -9,6 +9,7 @@ strategy, task ..., with the plugin manager's message). See docs/runner.md.
 from __future__ import annotations
 
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -990,8 +991,8 @@ def results(
             d["diagnostics_counts"] = t.diagnostics.get("counts", {})
             # every kind of event the trial recorded (detour, arm_contact, warning, ...), counted here
             # from the stored events: the stored counts above hold only the scoring's own
-            kinds = [e.get("kind") for e in t.diagnostics.get("events", [])]
-            d["event_counts"] = {k: kinds.count(k) for k in sorted(set(kinds), key=str)}
+            kinds = Counter(str(e.get("kind")) for e in t.diagnostics.get("events", []))
+            d["event_counts"] = dict(sorted(kinds.items()))
             data.append(d)
         emit_json(
             {"trials": data, "plot": plotted, "plot_off_scale": [o.to_dict() for o in off_scale]}

@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["UrdfJoint", "read_joints", "read_links", "read_parents"]
+__all__ = ["UrdfJoint", "downstream_links", "read_joints", "read_links"]
 
 MOVABLE = ("revolute", "prismatic", "continuous")
 
@@ -78,9 +78,18 @@ def read_links(urdf: str | Path) -> list[str]:
     return [lk.get("name") for lk in ET.parse(str(urdf)).getroot().findall("link")]
 
 
-def read_parents(urdf: str | Path) -> dict[str, str]:
-    """Each link's parent link, over every joint (fixed ones too): the URDF's link tree."""
-    root = ET.parse(str(urdf)).getroot()
-    return {
-        j.find("child").get("link"): j.find("parent").get("link") for j in root.findall("joint")
-    }
+def downstream_links(root: ET.Element) -> dict[str, list[str]]:
+    """Per joint of a parsed URDF (fixed ones too): the links it moves, its child and every link below
+    it in the link tree, depth first from the child."""
+    children: dict[str, list[str]] = {}
+    for j in root.findall("joint"):
+        children.setdefault(j.find("parent").get("link"), []).append(j.find("child").get("link"))
+    out: dict[str, list[str]] = {}
+    for j in root.findall("joint"):
+        links, stack = [], [j.find("child").get("link")]
+        while stack:
+            lk = stack.pop()
+            links.append(lk)
+            stack.extend(children.get(lk, []))
+        out[j.get("name")] = links
+    return out

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .description import downstream_links
 from .kinematics import KinematicTree
 
 __all__ = ["GravityModel"]
@@ -42,25 +43,18 @@ class GravityModel:
             self.com[link.get("name")] = np.array(
                 [float(x) for x in (o.get("xyz", "0 0 0") if o is not None else "0 0 0").split()]
             )
-        children: dict[str, list[tuple[str, str]]] = {}
         self.joints: dict[str, tuple[str, str, np.ndarray]] = {}  # name -> (type, child, axis)
         for j in root.findall("joint"):
-            parent = j.find("parent").get("link")
             child = j.find("child").get("link")
-            children.setdefault(parent, []).append((j.get("name"), child))
             ax = j.find("axis")
             axis = np.array(
                 [float(x) for x in (ax.get("xyz") if ax is not None else "1 0 0").split()]
             )
             self.joints[j.get("name")] = (j.get("type"), child, axis / np.linalg.norm(axis))
-        self.downstream: dict[str, list[str]] = {}
-        for name, (_, child, _) in self.joints.items():
-            links, stack = [], [child]
-            while stack:
-                lk = stack.pop()
-                links.append(lk)
-                stack.extend(c for _, c in children.get(lk, []))
-            self.downstream[name] = [lk for lk in links if self.mass.get(lk, 0.0) > 0]
+        self.downstream: dict[str, list[str]] = {
+            name: [lk for lk in links if self.mass.get(lk, 0.0) > 0]
+            for name, links in downstream_links(root).items()
+        }
         # Vectorised form: Q_j = a_j . ((S_j - M_j o_j) x g) with S_j = sum m_i c_i and M_j = sum m_i
         # over the links downstream of joint j (prismatic: Q_j = M_j g . a_j).
         self._links = [lk for lk in self.mass if self.mass[lk] > 0]

@@ -9,6 +9,7 @@ or opens a hand.
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -17,7 +18,7 @@ import numpy as np
 from ..backends.interface import Backend, BodyId
 from ..geometry import Pose
 from .config import RobotConfig
-from .description import UrdfJoint, read_joints, read_links, read_parents
+from .description import UrdfJoint, downstream_links, read_joints, read_links
 from .gravity import GravityModel
 from .kinematics import IKConfig
 from .parts import Gripper, RobotArm
@@ -95,16 +96,7 @@ class Robot:
     def links_below(self, joint: str) -> frozenset[str]:
         """The links ``joint`` moves: its child link and every link downstream of it (fixed joints
         included), e.g. an arm's links and its hand's from the arm's first joint."""
-        parents = read_parents(self.urdf_path)
-        top = self.urdf_joints[joint].child
-        out = set()
-        for link in parents.keys() | {top}:
-            x: str | None = link
-            while x is not None and x != top:
-                x = parents.get(x)
-            if x == top:
-                out.add(link)
-        return frozenset(out)
+        return frozenset(downstream_links(ET.fromstring(self.urdf_text))[joint])
 
     def tcp_links(self) -> dict[str, str]:
         out = {a.name: a.config.tcp_link for a in self.arms.values()}
