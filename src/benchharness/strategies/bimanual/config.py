@@ -62,10 +62,26 @@ class BimanualConfig:
     #: are summed, and a summed normal force of at least this (N) is recorded as an ``arm_contact`` event
     #: (the hand that moved, the move's label, the force, the pair of links pressing hardest). Record
     #: only: nothing is planned from it. Why: the arms are checked against each other only at a grip's
-    #: posture, and an elbow pressing on the holding arm moved the cube 27 mm without the belief knowing
-    #: (PyBullet Rubiks-1-100 sensor-aided seed 0, Intel VM: 63-160 N, found by a separate trace). None: no
-    #: check.
+    #: posture and on the moves ``arm_check`` covers, and an elbow pressing on the holding arm moved
+    #: the cube 27 mm without the belief knowing (PyBullet Rubiks-1-100 sensor-aided seed 0, Intel VM:
+    #: 63-160 N, found by a separate trace). None: no check.
     arm_contact_event: float | None = 5.0
+    #: with the grasp module's ``arm_margin``, every move the machine solves from the arm's joints
+    #: (:meth:`.machine.BimanualRubiksMachine.smooth_q`: a retreat's straight way out and its 2 cm steps,
+    #: a sideways retreat's steps, the pre-touch sweeps) must keep the arm clear of the other arm on its
+    #: joint path (margin >= 0 all the way; an arm that starts nearer, never nearer than it starts). The
+    #: nearest IK solution that does not is replaced by the clear one of least joint change among those
+    #: solved from the arm's joints with each joint moved by each of ``arm_check_offsets`` either way (the
+    #: 7-DOF arm's elbow swings about the shoulder-wrist line while the hand keeps its pose); an
+    #: ``arm_avoid`` event records it. With none, the move counts as one the arm cannot make smoothly (a
+    #: retreat goes sideways or is cut, a sweep is skipped). Moves to a grip's stand-off, the approach and
+    #: the hand-over turn are not checked this way (a grip's posture is, by the grasp module). Why: every
+    #: arm contact recorded in 14 sensor-aided PR2 trials (1-50, 1-100 and 5-20, both engines, AMD VM;
+    #: 20-70 N) was the giver's elbow on the taker's just after the hand-over's retreat, whose nearest
+    #: solution folds the elbow inwards as the hand backs off; on the Intel VM one such contact pushed the
+    #: holding arm 27 mm and ended PyBullet Rubiks-1-100 ``wrong_state``. False: no such check.
+    arm_check: bool = True
+    arm_check_offsets: tuple[float, ...] = (0.25, 0.5)
     #: a grip's stand-off and every step of a retreat must stay reachable (IK) with the target moved this
     #: many standard deviations of the injected per-motion position error (calibration and tracking,
     #: ``errors``) either way along each world axis, and turned as many of the calibration's rotation std

@@ -174,6 +174,11 @@ class GraspModule(Protocol):
     hand; with it the machine keeps a free hand's moves to its stand-offs from sweeping through
     the cube (:meth:`BimanualRubiksMachine.transit`). A module without it is not checked.
 
+    Optional: ``arm_margin(m, hand, q) -> np.ndarray``: how far (m) ``hand``'s arm at each row of joints
+    ``q`` stays beyond the robot's required clearance from the other arm where it is (negative: nearer);
+    with it the moves solved from the arm's joints (retreats, the pre-touch sweeps) keep the arms apart
+    (``arm_check``). A module without it is not checked.
+
     Optional: ``roll_offset(m, hand) -> float | None``: where the gripped layer's axis lies from the
     rotator's approach axis along its finger axis (m), as the hand's own closed fingers measure it (None:
     no reading); with it a twist turns the tool about that axis (:meth:`BimanualRubiksMachine.roll_about`)
@@ -611,15 +616,16 @@ class BimanualRubiksMachine:
             if h.holding:
                 h.cube_in_tcp = h.cmd.inv() * self.est
 
-    def _smooth(self, hand: Hand, target: Pose) -> bool:
-        """Whether the arm reaches ``target`` from its joints without any joint moving > max_waypoint_jump."""
-        return self.smooth_q(hand, target) is not None
-
-    def smooth_q(self, hand: Hand, target: Pose) -> np.ndarray | None:
+    def smooth_q(self, hand: Hand, target: Pose, label: str = "") -> np.ndarray | None:
         """The IK solution by which the arm reaches ``target`` from its joints without any joint moving
         more than ``max_waypoint_jump``, or None. Send the move seeded with it (``send(seed_q=...)``):
         solved again from the injected-error target, the arm can take another branch (measured: a
-        pre-touch sweep judged smooth swung the upper-arm and forearm rolls 3.1 rad, SAPIEN)."""
+        pre-touch sweep judged smooth swung the upper-arm and forearm rolls 3.1 rad, SAPIEN).
+
+        With the grasp module's ``arm_margin`` (``arm_check``), the joint path must also keep the arm
+        clear of the other arm (:meth:`_arm_clears`): if the nearest solution does not, the clear one of
+        least joint change among :meth:`_arm_clear_solutions` (an ``arm_avoid`` event naming ``label``),
+        else None."""
         base = hand.arm.base_pose()
         q = hand.arm.positions()
         res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
@@ -627,7 +633,24 @@ class BimanualRubiksMachine:
             bool(res.success[0])
             and float(np.max(np.abs(res.q[0] - q))) <= self.config.max_waypoint_jump
         )
-        return np.asarray(res.q[0], dtype=float) if ok else None
+        if not ok:
+            return None
+        q1 = np.asarray(res.q[0], dtype=float)
+        if self._arm_clears(hand, q, q1):
+            return q1
+        alternatives = self._arm_clear_solutions(hand, target, q)
+        self.ctx.recorder.event(
+            "arm_avoid",
+            hand=hand.side,
+            label=label,
+            nearest_change=round(float(np.max(np.abs(q1 - q))), 2),
+            **(
+                {"joint_change": round(float(np.max(np.abs(alternatives[0] - q))), 2)}
+                if alternatives
+                else {"found": False}
+            ),
+        )
+        return alternatives[0] if alternatives else None
 
     def turn_path(self, axis: str, angle: float) -> TurnPath:
         """The hand-over turn of the cube as believed now: ``angle`` rad about world ``axis`` through the
@@ -926,6 +949,45 @@ class BimanualRubiksMachine:
         start = self.sweep_clearance(hand, q0, q0, points, n=1)
         need = min(start - min(5e-3, 0.5 * start), self.config.sweep_clearance)
         return self.sweep_clearance(hand, q0, q1, points) >= need
+
+    def _arm_clears(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, n: int = 11) -> bool:
+        """Whether the straight joint path ``q0`` -> ``q1`` keeps ``hand``'s arm clear of the other arm where
+        it is: the grasp module's ``arm_margin`` at ``n`` points of the path never below 0 or, for an arm
+        that starts below it, never below where it starts. True without the hook or with
+        ``arm_check`` off."""
+        margin_of = getattr(self.grasp, "arm_margin", None)
+        if margin_of is None or not self.config.arm_check:
+            return True
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        margin = np.asarray(margin_of(self, hand, q0[None] + s * (q1 - q0)[None]), dtype=float)
+        return float(margin[1:].min()) >= min(0.0, float(margin[0])) - 1e-9
+
+    def _arm_clear_solutions(self, hand: Hand, target: Pose, q: np.ndarray) -> list[np.ndarray]:
+        """IK solutions of ``target`` other than the nearest one: solved from ``q`` with each joint moved by
+        each of ``arm_check_offsets`` either way (one batched call; no random draw, so a trial's plan
+        draws are untouched), kept if smooth (``max_waypoint_jump`` from ``q``) and :meth:`_arm_clears`,
+        by least joint change first."""
+        offsets = self.config.arm_check_offsets
+        if not offsets:
+            return []
+        seeds = np.stack(
+            [
+                q + s * d * np.eye(len(q))[j]
+                for j in range(len(q))
+                for d in offsets
+                for s in (1.0, -1.0)
+            ]
+        )
+        base = hand.arm.base_pose()
+        row = (base.inv() * target).as_matrix()
+        res = hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
+        found = []
+        for i in np.flatnonzero(np.asarray(res.success, dtype=bool)):
+            q1 = np.asarray(res.q[i], dtype=float)
+            change = float(np.max(np.abs(q1 - q)))
+            if change <= self.config.max_waypoint_jump and self._arm_clears(hand, q, q1):
+                found.append((change, int(i), q1))
+        return [q1 for _, _, q1 in sorted(found, key=lambda f: (f[0], f[1]))]
 
     def _line(
         self, hand: Hand, a: Pose, b: Pose, q: np.ndarray, points: np.ndarray, step: float = 0.02
@@ -1331,9 +1393,9 @@ class BimanualRubiksMachine:
         points = self._hand_points()
 
         def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
-            """Smooth, within reach with the injected errors' margin, and (with hand points) clear of the
-            cube; the IK solution to seed the move with."""
-            q1 = self.smooth_q(hand, target)
+            """Smooth and clear of the other arm (:meth:`smooth_q`), within reach with the injected errors'
+            margin, and (with hand points) clear of the cube; the IK solution to seed the move with."""
+            q1 = self.smooth_q(hand, target, label="retreat")
             if q1 is None or not self.reachable(hand, target, q1):
                 return False, None
             if points is None:
@@ -1428,7 +1490,8 @@ class BimanualRubiksMachine:
         stop_on_fail: bool,
     ) -> tuple[list[tuple[Pose, np.ndarray, str]], np.ndarray, bool]:
         """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``), within reach
-        with the injected errors' margin (:meth:`reachable`) and its joint path clear (:meth:`_clears`):
+        with the injected errors' margin (:meth:`reachable`), its joint path clear of the cube (:meth:`_clears`)
+        and of the other arm (:meth:`_arm_clears`):
         the waypoints (pose, IK solution, ``label``) that pass, the last solution, and whether all passed
         (``stop_on_fail``: stop at the first that fails, else give up)."""
         out: list[tuple[Pose, np.ndarray, str]] = []
@@ -1437,6 +1500,7 @@ class BimanualRubiksMachine:
             if (
                 q1 is None
                 or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
+                or not self._arm_clears(hand, q, q1)
                 or not self.reachable(hand, way, q1)
                 or not self._clears(hand, q, q1, points)
             ):

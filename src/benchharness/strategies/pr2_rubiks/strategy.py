@@ -134,6 +134,12 @@ class PR2Grasp:
         them clear of the cube when the free hand moves to a stand-off (``sweep_clearance``)."""
         return _open_hand_points()
 
+    def arm_margin(self, m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
+        """How far (m) the arm at each row of ``q`` stays beyond ``arm_clearance`` from the other arm where
+        it is, both modelled as ``ARM_RADIUS`` round their axes (:func:`arm_clearance`): the machine keeps
+        the moves it solves from the arm's joints from bringing it below 0 (``arm_check``)."""
+        return arm_clearance(m, hand, np.atleast_2d(q)) - self.config.arm_clearance
+
     def take_relation(self) -> str | None:
         # in a hand-over the giver's finger lies on the face the taker comes to: only crossing fingers pass it
         return "cross"
@@ -635,7 +641,7 @@ class PR2SensorAidedGrasp(PR2Grasp):
             # palm hit the cube held by the other hand alone at 25 N and turned it 31 degrees)
             finger, q_a = None, None
             for f in order:
-                q_a = m.smooth_q(hand, tool_at(start, f))
+                q_a = m.smooth_q(hand, tool_at(start, f), label=f"{label} pre-touch {name} start")
                 if q_a is not None:
                     finger = f
                     break
@@ -651,7 +657,7 @@ class PR2SensorAidedGrasp(PR2Grasp):
             except StrategyFailure:  # the injected errors put the target just out of reach
                 skipped.append(name)
                 continue
-            q_b = m.smooth_q(hand, b_pose)
+            q_b = m.smooth_q(hand, b_pose, label=f"{label} pre-touch {name}")
             if q_b is None:
                 skipped.append(name)
                 continue
