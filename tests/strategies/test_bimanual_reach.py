@@ -173,8 +173,9 @@ def test_retreat_steps_stop_where_the_injected_errors_margin_leaves_the_reach():
     # the 4th step (y = 0.11, 0.51 m from the shoulder) in reach, its margin box not
     reach = float(np.linalg.norm(steps[3].p - shoulder)) + 0.002
     for cfg, expect in (({}, 3), ({"reach_sigmas": None}, 4)):
-        m, Hand, grip, shoulder = _machine(**cfg)
-        m._clears = lambda *a: True  # no FK model here: the sweep check is not what is tested
+        # no FK model here: neither the sweep check nor the arm check is what is tested
+        m, Hand, grip, shoulder = _machine(arm_check=False, **cfg)
+        m._clears = lambda *a: True
         hand = Hand("left", _SphereArm(shoulder, reach), None, Pose(np.zeros(3)), grip)
         out, _, _ = m._chain(hand, np.zeros(7), steps, "retreat step", np.zeros((1, 3)), True)
         assert len(out) == expect
