@@ -635,7 +635,14 @@ class BimanualRubiksMachine:
         )
         if not ok:
             return None
-        q1 = np.asarray(res.q[0], dtype=float)
+        return self._arms_apart(hand, target, q, np.asarray(res.q[0], dtype=float), label)
+
+    def _arms_apart(
+        self, hand: Hand, target: Pose, q: np.ndarray, q1: np.ndarray, label: str
+    ) -> np.ndarray | None:
+        """``q1`` (an IK solution of ``target`` near ``q``) if its joint path from ``q`` keeps the arm clear
+        of the other arm (:meth:`_arm_clears`), else the clear one of least joint change among
+        :meth:`_arm_clear_solutions` (an ``arm_avoid`` event naming ``label``), else None."""
         if self._arm_clears(hand, q, q1):
             return q1
         alternatives = self._arm_clear_solutions(hand, target, q)
@@ -990,15 +997,25 @@ class BimanualRubiksMachine:
         return [q1 for _, _, q1 in sorted(found, key=lambda f: (f[0], f[1]))]
 
     def _line(
-        self, hand: Hand, a: Pose, b: Pose, q: np.ndarray, points: np.ndarray, step: float = 0.02
+        self,
+        hand: Hand,
+        a: Pose,
+        b: Pose,
+        q: np.ndarray,
+        points: np.ndarray,
+        label: str,
+        step: float = 0.02,
     ) -> list[tuple[Pose, np.ndarray]] | None:
         """Waypoints (pose, IK solution) at most ``step`` apart on the straight line from ``a`` to ``b``
-        (same orientation), each solved from the last and each joint path clear; None if not."""
+        (same orientation), each solved from the last and each joint path clear of the cube and of the
+        other arm (:meth:`_arms_apart`, ``label`` for its event); None if not."""
         n = max(1, math.ceil(float(np.linalg.norm(b.p - a.p)) / step))
         out = []
         for i in range(1, n + 1):
             way = Pose(a.p + (b.p - a.p) * i / n, b.q)
             q1 = self.ik_q(hand, way, q)
+            if q1 is not None:
+                q1 = self._arms_apart(hand, way, q, q1, label)
             if q1 is None or not self._clears(hand, q, q1, points):
                 return None
             out.append((way, q1))
@@ -1146,7 +1163,7 @@ class BimanualRubiksMachine:
         (``way_out`` None) that is not clear is left out and the turn is checked from where the hand
         is; another way out (``way_out`` names it in the event) must be clear."""
         cfg = self.config
-        leg_out = self._line(hand, hand.cmd, out, q0, points)
+        leg_out = self._line(hand, hand.cmd, out, q0, points, f"{label} detour out")
         if leg_out is None:
             if way_out is not None:
                 return False
@@ -1159,7 +1176,7 @@ class BimanualRubiksMachine:
         qb = self.ik_q(hand, turned, plan_seed)
         if qb is None or not self._clears(hand, qa, qb, points):
             return False
-        leg_in = self._line(hand, turned, target, qb, points)
+        leg_in = self._line(hand, turned, target, qb, points, f"{label} detour in")
         if leg_in is None:
             return False
         self.ctx.recorder.event(
@@ -1497,10 +1514,11 @@ class BimanualRubiksMachine:
         out: list[tuple[Pose, np.ndarray, str]] = []
         for way in poses:
             q1 = self.ik_q(hand, way, q)
+            if q1 is not None and float(np.max(np.abs(q1 - q))) <= self.config.max_waypoint_jump:
+                q1 = self._arms_apart(hand, way, q, q1, label)
             if (
                 q1 is None
                 or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
-                or not self._arm_clears(hand, q, q1)
                 or not self.reachable(hand, way, q1)
                 or not self._clears(hand, q, q1, points)
             ):
