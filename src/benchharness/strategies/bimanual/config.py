@@ -74,7 +74,8 @@ class BimanualConfig:
     #: solved from the arm's joints with each joint moved by each of ``arm_check_offsets`` either way (the
     #: 7-DOF arm's elbow swings about the shoulder-wrist line while the hand keeps its pose); an
     #: ``arm_avoid`` event records it. With none, the move counts as one the arm cannot make smoothly (a
-    #: retreat goes sideways or is cut, a sweep is skipped). Moves to a grip's stand-off, the approach and
+    #: retreat goes sideways or is cut, a sweep is skipped), except on a detour's legs, the way round the
+    #: cube, which are made as before (the event says ``found: false``). Moves to a grip's stand-off, the approach and
     #: the hand-over turn are not checked this way (a grip's posture is, by the grasp module). Why: every
     #: arm contact recorded in 14 sensor-aided PR2 trials (1-50, 1-100 and 5-20, both engines, AMD VM;
     #: 20-70 N) was the giver's elbow on the taker's just after the hand-over's retreat, whose nearest
