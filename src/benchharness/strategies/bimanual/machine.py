@@ -176,8 +176,8 @@ class GraspModule(Protocol):
 
     Optional: ``arm_margin(m, hand, q) -> np.ndarray``: how far (m) ``hand``'s arm at each row of joints
     ``q`` stays beyond the robot's required clearance from the other arm where it is (negative: nearer);
-    with it the moves solved from the arm's joints (retreats, the pre-touch sweeps) keep the arms apart
-    (``arm_check``). A module without it is not checked.
+    with it the moves solved from the arm's joints (retreats, the pre-touch sweeps; a detour's straight
+    legs as a preference) keep the arms apart (``arm_check``). A module without it is not checked.
 
     Optional: ``roll_offset(m, hand) -> float | None``: where the gripped layer's axis lies from the
     rotator's approach axis along its finger axis (m), as the hand's own closed fingers measure it (None:
@@ -623,9 +623,8 @@ class BimanualRubiksMachine:
         pre-touch sweep judged smooth swung the upper-arm and forearm rolls 3.1 rad, SAPIEN).
 
         With the grasp module's ``arm_margin`` (``arm_check``), the joint path must also keep the arm
-        clear of the other arm (:meth:`_arm_clears`): if the nearest solution does not, the clear one of
-        least joint change among :meth:`_arm_clear_solutions` (an ``arm_avoid`` event naming ``label``),
-        else None."""
+        clear of the other arm (:meth:`_arms_apart`): if the nearest solution does not, the clear one of
+        least joint change (an ``arm_avoid`` event naming ``label``), else None."""
         base = hand.arm.base_pose()
         q = hand.arm.positions()
         res = hand.arm.ik((base.inv() * target).as_matrix()[None], seed_q=q)
@@ -647,25 +646,25 @@ class BimanualRubiksMachine:
         veto: bool = True,
     ) -> np.ndarray | None:
         """``q1`` (an IK solution of ``target`` near ``q``) if its joint path from ``q`` keeps the arm clear
-        of the other arm (:meth:`_arm_clears`), else the clear one of least joint change among
-        :meth:`_arm_clear_solutions` (an ``arm_avoid`` event naming ``label``), else None, or ``q1`` if
+        of the other arm (:meth:`_arm_clears`), else :meth:`_arm_clear_solution` (an ``arm_avoid`` event
+        naming ``label``), else None, or ``q1`` if
         not ``veto`` (a preference only: the event says ``found: false`` and the move is made as it was)."""
         if self._arm_clears(hand, q, q1):
             return q1
-        alternatives = self._arm_clear_solutions(hand, target, q)
+        other = self._arm_clear_solution(hand, target, q)
         self.ctx.recorder.event(
             "arm_avoid",
             hand=hand.side,
             label=label,
             nearest_change=round(float(np.max(np.abs(q1 - q))), 2),
             **(
-                {"joint_change": round(float(np.max(np.abs(alternatives[0] - q))), 2)}
-                if alternatives
+                {"joint_change": round(float(np.max(np.abs(other - q))), 2)}
+                if other is not None
                 else {"found": False}
             ),
         )
-        if alternatives:
-            return alternatives[0]
+        if other is not None:
+            return other
         return None if veto else q1
 
     def turn_path(self, axis: str, angle: float) -> TurnPath:
@@ -978,14 +977,14 @@ class BimanualRubiksMachine:
         margin = np.asarray(margin_of(self, hand, q0[None] + s * (q1 - q0)[None]), dtype=float)
         return float(margin[1:].min()) >= min(0.0, float(margin[0])) - 1e-9
 
-    def _arm_clear_solutions(self, hand: Hand, target: Pose, q: np.ndarray) -> list[np.ndarray]:
-        """IK solutions of ``target`` other than the nearest one: solved from ``q`` with each joint moved by
-        each of ``arm_check_offsets`` either way (one batched call; no random draw, so a trial's plan
-        draws are untouched), kept if smooth (``max_waypoint_jump`` from ``q``) and :meth:`_arm_clears`,
-        by least joint change first."""
+    def _arm_clear_solution(self, hand: Hand, target: Pose, q: np.ndarray) -> np.ndarray | None:
+        """Another IK solution of ``target``: of those solved from ``q`` with each joint moved by each of
+        ``arm_check_offsets`` either way (one batched call; no random draw, so a trial's plan draws are
+        untouched) that are smooth (``max_waypoint_jump`` from ``q``) and :meth:`_arm_clears`, the one of
+        least joint change (the first seed on a tie); None if none is."""
         offsets = self.config.arm_check_offsets
         if not offsets:
-            return []
+            return None
         seeds = np.stack(
             [
                 q + s * d * np.eye(len(q))[j]
@@ -997,13 +996,17 @@ class BimanualRubiksMachine:
         base = hand.arm.base_pose()
         row = (base.inv() * target).as_matrix()
         res = hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
-        found = []
+        best: tuple[float, np.ndarray] | None = None
         for i in np.flatnonzero(np.asarray(res.success, dtype=bool)):
             q1 = np.asarray(res.q[i], dtype=float)
             change = float(np.max(np.abs(q1 - q)))
-            if change <= self.config.max_waypoint_jump and self._arm_clears(hand, q, q1):
-                found.append((change, int(i), q1))
-        return [q1 for _, _, q1 in sorted(found, key=lambda f: (f[0], f[1]))]
+            if (
+                change <= self.config.max_waypoint_jump
+                and (best is None or change < best[0])
+                and self._arm_clears(hand, q, q1)
+            ):
+                best = (change, q1)
+        return None if best is None else best[1]
 
     def _line(
         self,
@@ -1521,17 +1524,18 @@ class BimanualRubiksMachine:
     ) -> tuple[list[tuple[Pose, np.ndarray, str]], np.ndarray, bool]:
         """Solve ``poses`` one after another from ``q``, each smooth (``max_waypoint_jump``), within reach
         with the injected errors' margin (:meth:`reachable`), its joint path clear of the cube (:meth:`_clears`)
-        and of the other arm (:meth:`_arm_clears`):
+        and of the other arm (:meth:`_arms_apart`: another posture if the nearest is not):
         the waypoints (pose, IK solution, ``label``) that pass, the last solution, and whether all passed
         (``stop_on_fail``: stop at the first that fails, else give up)."""
         out: list[tuple[Pose, np.ndarray, str]] = []
         for way in poses:
             q1 = self.ik_q(hand, way, q)
-            if q1 is not None and float(np.max(np.abs(q1 - q))) <= self.config.max_waypoint_jump:
+            if q1 is not None and float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump:
+                q1 = None
+            if q1 is not None:
                 q1 = self._arms_apart(hand, way, q, q1, label)
             if (
                 q1 is None
-                or float(np.max(np.abs(q1 - q))) > self.config.max_waypoint_jump
                 or not self.reachable(hand, way, q1)
                 or not self._clears(hand, q, q1, points)
             ):
