@@ -69,15 +69,17 @@ class BimanualConfig:
     #: with the grasp module's ``arm_margin``, every move the machine solves from the arm's joints
     #: (:meth:`.machine.BimanualRubiksMachine.smooth_q`: a retreat's straight way out and its 2 cm steps,
     #: a sideways retreat's steps, the pre-touch sweeps; and, as a preference only, a detour's straight
-    #: legs) must keep the arm clear of the other arm on its joint path (margin >= 0 all the way; an arm
-    #: that starts nearer, never nearer than it starts). The nearest IK solution that does not is replaced
+    #: legs; a detour whose legs and turn all keep clear is taken before any that does not, its way out
+    #: along the approach, up or sideways: ``transit``) must keep the arm clear of the other arm on its
+    #: joint path (margin >= 0 all the way; an arm that starts nearer, never nearer than it starts). The
+    #: nearest IK solution that does not is replaced
     #: by the clear one of least joint change among those solved from the arm's joints with each joint
     #: moved by each of ``arm_check_offsets`` either way (the 7-DOF arm's elbow swings about the
     #: shoulder-wrist line while the hand keeps its pose); an ``arm_avoid`` event records it. With none,
     #: the move counts as one the arm cannot make smoothly (a retreat goes sideways or is cut, a sweep is
     #: skipped), except a detour's step, made as before (the event says ``found: false``: refusing it
     #: ended SAPIEN Rubiks-1-50 ``unreachable`` where the move, elbows touching, had been harmless). Moves
-    #: to a grip's stand-off, a detour's turn, the approach and the hand-over turn are not checked this
+    #: to a grip's stand-off (beyond its detour), the approach and the hand-over turn are not checked this
     #: way (a grip's posture is, by the grasp module). Why: every arm contact recorded in 14 sensor-aided
     #: PR2 trials (1-50, 1-100 and 5-20, both engines, AMD VM; 20-70 N) was the giver's elbow on the
     #: taker's just after the hand-over's retreat, whose nearest solution folds the elbow inwards as the

@@ -98,6 +98,28 @@ class Hand:
     log: list = field(default_factory=list)
 
 
+@dataclass
+class _Detour:
+    """A planned detour of :meth:`BimanualRubiksMachine.transit` (nothing moved yet): the straight way
+    out (poses with their IK solutions; empty: the turn starts where the hand is), the joint-space turn
+    to ``turned`` (solution ``qb``), the straight way in, which way out (None: along the approach), and
+    the ``arm_avoid`` events its planning kept back."""
+
+    q0: np.ndarray
+    leg_out: list[tuple[Pose, np.ndarray]]
+    turned: Pose
+    qb: np.ndarray
+    leg_in: list[tuple[Pose, np.ndarray]]
+    way_out: str | None
+    notes: list[dict]
+
+    def joint_steps(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Every straight joint-space path the detour makes, in order (out, turn, in)."""
+        qs = [self.q0, *(q for _, q in self.leg_out), self.qb]
+        ins = [self.qb, *(q for _, q in self.leg_in)]
+        return list(zip(qs[:-1], qs[1:], strict=True)) + list(zip(ins[:-1], ins[1:], strict=True))
+
+
 def _shifted(pose: Pose, shift: np.ndarray) -> Pose:
     """``pose`` translated by ``shift`` (m, world)."""
     return Pose(pose.p + shift, pose.q)
@@ -644,16 +666,17 @@ class BimanualRubiksMachine:
         q1: np.ndarray,
         label: str,
         veto: bool = True,
+        notes: list[dict] | None = None,
     ) -> np.ndarray | None:
         """``q1`` (an IK solution of ``target`` near ``q``) if its joint path from ``q`` keeps the arm clear
         of the other arm (:meth:`_arm_clears`), else :meth:`_arm_clear_solution` (an ``arm_avoid`` event
         naming ``label``), else None, or ``q1`` if
-        not ``veto`` (a preference only: the event says ``found: false`` and the move is made as it was)."""
+        not ``veto`` (a preference only: the event says ``found: false`` and the move is made as it was).
+        ``notes``: a plan not yet made keeps its events there instead (recorded if it is made)."""
         if self._arm_clears(hand, q, q1):
             return q1
         other = self._arm_clear_solution(hand, target, q)
-        self.ctx.recorder.event(
-            "arm_avoid",
+        note = dict(
             hand=hand.side,
             label=label,
             nearest_change=round(float(np.max(np.abs(q1 - q))), 2),
@@ -663,6 +686,10 @@ class BimanualRubiksMachine:
                 else {"found": False}
             ),
         )
+        if notes is None:
+            self.ctx.recorder.event("arm_avoid", **note)
+        else:
+            notes.append(note)
         if other is not None:
             return other
         return None if veto else q1
@@ -1017,11 +1044,12 @@ class BimanualRubiksMachine:
         points: np.ndarray,
         label: str,
         step: float = 0.02,
+        notes: list[dict] | None = None,
     ) -> list[tuple[Pose, np.ndarray]] | None:
         """Waypoints (pose, IK solution) at most ``step`` apart on the straight line from ``a`` to ``b``
         (same orientation), each solved from the last and each joint path clear of the cube (None if
         not); of the solutions clear of the cube, one clear of the other arm where there is one
-        (:meth:`_arms_apart`, not a veto; ``label`` for its event)."""
+        (:meth:`_arms_apart`, not a veto; ``label`` for its event, kept in ``notes`` if given)."""
         n = max(1, math.ceil(float(np.linalg.norm(b.p - a.p)) / step))
         out = []
         for i in range(1, n + 1):
@@ -1031,7 +1059,7 @@ class BimanualRubiksMachine:
                 # a preference, not a veto: a detour is the way round the cube, and one refused for a
                 # posture the (conservative) capsules call unclear ended a trial that had made that
                 # move with the elbows touching (45 N) and completed (SAPIEN Rubiks-1-50, 1385.6 s)
-                q1 = self._arms_apart(hand, way, q, q1, label, veto=False)
+                q1 = self._arms_apart(hand, way, q, q1, label, veto=False, notes=notes)
             if q1 is None or not self._clears(hand, q, q1, points):
                 return None
             out.append((way, q1))
@@ -1058,7 +1086,9 @@ class BimanualRubiksMachine:
         the first of ``detour_distances`` from which the swing to the stand-off's
         orientation and the straight way back in (in 2 cm steps) stay clear (where the
         straight way out is not clear, the swing is checked from where the hand is), and
-        a ``detour`` event is recorded. If none does, the direct move is made and
+        a ``detour`` event is recorded. With the arm check (``arm_check``, the grasp module's
+        ``arm_margin``) a detour that also keeps the arm clear of the other arm, out along the approach,
+        up or sideways, comes first (:meth:`_arm_clear_detour`). If none does, the direct move is made and
         a warning recorded, unless its path enters the believed cube or the table from a start
         outside them: then the trial ends ``unreachable`` (the move would knock the cube).
 
@@ -1081,6 +1111,12 @@ class BimanualRubiksMachine:
             self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
         clear = self.sweep_clearance(hand, q0, q1, points)
+        apart = self._arm_clear_detour(hand, target, q0, plan_seed, points, label)
+        if apart is not None:
+            self._make_detour(
+                hand, apart[1], label, settle, clear=clear, distance=apart[0], branch_change=detour
+            )
+            return
         c = self.est.p
         r0 = float(np.linalg.norm(hand.cmd.p - c))
         r1 = float(np.linalg.norm(target.p - c))
@@ -1172,17 +1208,39 @@ class BimanualRubiksMachine:
         branch_change: bool = False,
         way_out: str | None = None,
     ) -> bool:
-        """One detour of :meth:`transit`, made if every leg is clear: straight out from the command to
+        """One detour of :meth:`transit`, made if every leg is clear of the cube (:meth:`_plan_detour`);
+        False (nothing moved) if a leg is not. ``clear`` (the direct move's clearance) and ``distance``
+        are recorded in the ``detour`` event."""
+        plan = self._plan_detour(hand, target, out, turned, q0, plan_seed, points, label, way_out)
+        if plan is None:
+            return False
+        self._make_detour(
+            hand, plan, label, settle, clear=clear, distance=distance, branch_change=branch_change
+        )
+        return True
+
+    def _plan_detour(
+        self,
+        hand: Hand,
+        target: Pose,
+        out: Pose,
+        turned: Pose,
+        q0: np.ndarray,
+        plan_seed: np.ndarray,
+        points: np.ndarray,
+        label: str,
+        way_out: str | None,
+        notes: list[dict] | None = None,
+    ) -> _Detour | None:
+        """A detour's legs, each clear of the believed cube, or None: straight out from the command to
         ``out``, a joint-space turn to ``turned`` (the target backed off along its approach), straight in
-        to ``target``; False (nothing moved) if a leg is not clear. ``clear`` (the direct move's clearance)
-        and ``distance`` are recorded in the ``detour`` event. The way out along the approach
-        (``way_out`` None) that is not clear is left out and the turn is checked from where the hand
-        is; another way out (``way_out`` names it in the event) must be clear."""
-        cfg = self.config
-        leg_out = self._line(hand, hand.cmd, out, q0, points, f"{label} detour out")
+        to ``target``. The way out along the approach (``way_out`` None) that is not clear is left out
+        and the turn is checked from where the hand is; another way out (``way_out`` names it) must be
+        clear. Nothing moves; ``notes`` as for :meth:`_line`."""
+        leg_out = self._line(hand, hand.cmd, out, q0, points, f"{label} detour out", notes=notes)
         if leg_out is None:
             if way_out is not None:
-                return False
+                return None
             # no straight way out (a joint limit on it): the joint-space turn to the stand-off's
             # orientation from here, if that alone is clear (measured: a giver that had slid out
             # sideways beside the cube, its shoulder pan and upper-arm roll on their soft limits,
@@ -1191,19 +1249,85 @@ class BimanualRubiksMachine:
         qa = leg_out[-1][1] if leg_out else q0
         qb = self.ik_q(hand, turned, plan_seed)
         if qb is None or not self._clears(hand, qa, qb, points):
-            return False
-        leg_in = self._line(hand, turned, target, qb, points, f"{label} detour in")
+            return None
+        leg_in = self._line(hand, turned, target, qb, points, f"{label} detour in", notes=notes)
         if leg_in is None:
-            return False
+            return None
+        return _Detour(q0, leg_out, turned, qb, leg_in, way_out, [] if notes is None else notes)
+
+    def _arm_clear_detour(
+        self,
+        hand: Hand,
+        target: Pose,
+        q0: np.ndarray,
+        plan_seed: np.ndarray,
+        points: np.ndarray,
+        label: str,
+    ) -> tuple[float, _Detour] | None:
+        """The first detour (and its distance) whose every leg is clear of the cube *and* keeps the arm
+        clear of the other arm (:meth:`_arm_clears` on each step's joint path, the turn's included): out
+        along the approach at each of ``detour_distances``, then straight up, then towards the stand-off's
+        side of the cube. None without the grasp module's ``arm_margin``, with ``arm_check`` off, or if no
+        detour is clear of both; :meth:`transit` then takes its detour as before. Nothing moves and no
+        event is recorded here.
+
+        Why: every arm contact left in 34 sensor-aided PR2 trials with the retreats checked (AMD VM,
+        3b6e43c: 7 of 8, 16-71 N, elbow on elbow) was a hand-over's giver in front of the cube backing
+        out along its approach, towards the taker's elbow, on its way to a re-grip stand-off at the
+        cube's side; for 17 of the 19 steps flagged no elbow posture was clear, so only another way out
+        helps (measured, SAPIEN Rubiks-5-20 seed 1 trial 3 at 277.7 s: out along the approach the
+        margin falls to -44 mm at 25 and 35 cm; sideways towards the stand-off it stays 3.3 mm)."""
+        if getattr(self.grasp, "arm_margin", None) is None or not self.config.arm_check:
+            return None
+        c = self.est.p
+        r0 = float(np.linalg.norm(hand.cmd.p - c))
+        r1 = float(np.linalg.norm(target.p - c))
+        side = target.p - c
+        ways: list[tuple[str | None, np.ndarray | None]] = [
+            (None, None),
+            ("up", np.array([0.0, 0.0, 1.0])),
+            ("side", side / max(float(np.linalg.norm(side)), 1e-9)),
+        ]
+        for name, direction in ways:
+            for d in self.config.detour_distances:
+                if direction is None:
+                    out = self.back_off(hand.cmd, max(0.0, d - r0))
+                else:
+                    out = Pose(hand.cmd.p + max(0.0, d - r0) * direction, hand.cmd.q)
+                turned = self.back_off(target, max(0.0, d - r1))
+                plan = self._plan_detour(
+                    hand, target, out, turned, q0, plan_seed, points, label, name, notes=[]
+                )
+                if plan is not None and all(
+                    self._arm_clears(hand, a, b) for a, b in plan.joint_steps()
+                ):
+                    return d, plan
+        return None
+
+    def _make_detour(
+        self,
+        hand: Hand,
+        plan: _Detour,
+        label: str,
+        settle: float,
+        *,
+        clear: float,
+        distance: float,
+        branch_change: bool = False,
+    ) -> None:
+        """Make a planned detour: its kept ``arm_avoid`` events, the ``detour`` event, then the moves."""
+        cfg = self.config
+        for note in plan.notes:
+            self.ctx.recorder.event("arm_avoid", **note)
         self.ctx.recorder.event(
             "detour",
             hand=hand.side,
             label=label,
             clearance_mm=round(1000 * clear, 1),
             distance_m=distance,
-            straight_out=bool(leg_out),
+            straight_out=bool(plan.leg_out),
             **({"branch_change": True} if branch_change else {}),
-            **({"way_out": way_out} if way_out is not None else {}),
+            **({"way_out": plan.way_out} if plan.way_out is not None else {}),
         )
         # the way out and the turn are via points in free space, moving away from the cube: they
         # were solved for the believed pose; the injected calibration can put the arm's target just
@@ -1211,7 +1335,7 @@ class BimanualRubiksMachine:
         # a way-out step 0.9 mm short, seeded on its planned chain, once an unconverged move was no
         # longer made, PyBullet Rubiks-1-20 at 66b020b), which within ``sweep_clearance`` leaves the
         # detour's clearance argument intact
-        for way, q in leg_out:
+        for way, q in plan.leg_out:
             self.send(
                 hand,
                 way,
@@ -1222,14 +1346,14 @@ class BimanualRubiksMachine:
             )
         self.send(
             hand,
-            turned,
+            plan.turned,
             label=f"{label} detour turn",
             settle=0.02,
-            seed_q=qb,
+            seed_q=plan.qb,
             slack=cfg.sweep_clearance,
         )
-        for k, (way, q) in enumerate(leg_in):
-            last = k == len(leg_in) - 1
+        for k, (way, q) in enumerate(plan.leg_in):
+            last = k == len(plan.leg_in) - 1
             self.send(
                 hand,
                 way,
@@ -1237,7 +1361,6 @@ class BimanualRubiksMachine:
                 settle=settle if last else 0.02,
                 seed_q=q,
             )
-        return True
 
     def _arc(self, c: np.ndarray, dirs: list, quats: list, r0: float, r1: float) -> list[Pose]:
         """Waypoints (tool poses, the ends left out) on great-circle legs about ``c`` through the unit
