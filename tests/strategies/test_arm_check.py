@@ -8,10 +8,10 @@ arm ended (that solution plus the trial's injected arm errors, a few mrad) they 
 both engines. The solution the machine takes instead reaches the same pose with the arms apart, and
 stays apart with the same joint error added.
 
-The second case is a detour (SAPIEN Rubiks-5-20 sensor-aided seed 1 trial 3, 277.7 s): a giver in front
-of the cube backing out along its approach on its way to a stand-off at the cube's side put its elbow
-on the holding arm's (66.5 N in that trial; 55-65 N here). No elbow posture keeps that way out clear;
-the machine goes out sideways instead, and the engines find no contact.
+The other cases are detours (``DETOURS``, two trials): a giver in front of the cube backing out along its
+approach on its way to a stand-off at the cube's side put its elbow on the holding arm's (50-67 N in
+the trials, as much here). No elbow posture keeps that way out clear; the machine goes out another way
+(sideways, or sideways and up), and the engines find no contact.
 """
 
 from __future__ import annotations
@@ -89,22 +89,41 @@ def test_a_retreat_that_folds_the_elbow_onto_the_other_arm_is_solved_on_another_
     assert avoid and avoid[-1]["label"] == "retreat" and "joint_change" in avoid[-1]
 
 
-#: a hand-over's giver in front of the cube on its way to a re-grip stand-off at the cube's left side,
-#: recorded at 277.67 s of SAPIEN Rubiks-5-20 sensor-aided seed 1 trial 3 (3b6e43c): the free (left)
-#: arm's joints, the holding (right) arm's, the left tool's commanded pose, the stand-off, the
-#: believed cube (the left arm's base frame, x, y, z, qx, qy, qz, qw) and the grip's planned joints.
-#: Backing out along its approach, that trial's left elbow met the right one (66.5 N).
-GIVER_Q = [-0.4106, -0.0306, 3.0418, -1.982, 2.7217, -1.9477, 6.1717]
-HOLDER_Q = [0.1447, 0.031, -3.4974, -1.0858, 1.8658, -1.7788, -1.0655]
-GIVER_CMD = [0.516573, 0.003589, -0.288849, -0.020656, 0.009211, -0.013272, 0.999656]
-STANDOFF = [0.650051, 0.179229, -0.294863, -0.494756, 0.516371, 0.488256, -0.500184]
-CUBE = [0.648241, -0.000492, -0.288851, -0.494756, 0.516371, 0.488256, -0.500184]
-PLAN_Q = [-0.208, 0.1237, 3.7388, -1.0331, 4.1685, -2.0, 7.2848]
+#: a hand-over's giver in front of the cube on its way to a re-grip stand-off at the cube's side, recorded
+#: where the trial's detour backed out along the approach into the holding arm's elbow: the free arm's
+#: side, its joints, the holding arm's, the free tool's commanded pose, the stand-off, the believed cube
+#: (the free arm's base frame, x, y, z, qx, qy, qz, qw), the grip's planned joints, and the way out the
+#: machine takes instead. "side": SAPIEN Rubiks-5-20 sensor-aided seed 1 trial 3 at 277.67 s (66.5 N in
+#: that trial, at 3b6e43c); "side-up": SAPIEN Rubiks-1-50 seed 0 at 1385.6 s (50.3 N), where the turns
+#: from straight up and straight sideways would sweep the cube.
+DETOURS = {
+    "side": (
+        "left",
+        [-0.4106, -0.0306, 3.0418, -1.982, 2.7217, -1.9477, 6.1717],
+        [0.1447, 0.031, -3.4974, -1.0858, 1.8658, -1.7788, -1.0655],
+        [0.516573, 0.003589, -0.288849, -0.020656, 0.009211, -0.013272, 0.999656],
+        [0.650051, 0.179229, -0.294863, -0.494756, 0.516371, 0.488256, -0.500184],
+        [0.648241, -0.000492, -0.288851, -0.494756, 0.516371, 0.488256, -0.500184],
+        [-0.208, 0.1237, 3.7388, -1.0331, 4.1685, -2.0, 7.2848],
+    ),
+    "side-up": (
+        "right",
+        [0.4451, -0.0134, -3.0723, -1.9644, -2.6792, -1.9394, 7.9505],
+        [-0.1226, 0.0416, 3.4516, -1.0585, 10.7539, -1.7702, -22.5014],
+        [0.51528, -0.002399, -0.290634, -0.70269, -0.010427, -0.008613, -0.711367],
+        [0.649346, -0.161682, -0.294616, -0.499343, -0.502798, 0.492766, 0.505007],
+        [0.650776, 0.001623, -0.292049, -0.004651, -0.712626, 0.701527, 0.001563],
+        [-0.3771, 0.7689, -1.038, -1.02, -0.8587, -1.1151, 6.2123],
+    ),
+}
 LABEL = "hand-over re-grip stand-off"
 
 
+@pytest.mark.parametrize("way", sorted(DETOURS))
 @pytest.mark.parametrize("backend", ("pybullet", "sapien"))
-def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_sideways(make_ctx, backend):
+def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way(
+    make_ctx, backend, way
+):
     from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
     from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
 
@@ -112,17 +131,18 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_sideways(ma
     st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
     assert st.run_trial(ctx).failure is None
     robot = ctx.robot
-    left, right = st.hands["left"], st.hands["right"]
+    side, free_q, hold_q, cmd, standoff, cube, plan_q = DETOURS[way]
+    free, hold = st.hands[side], st.other(st.hands[side])
     links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
-    base = left.arm.base_pose()
-    q0, seed = np.array(GIVER_Q), np.array(PLAN_Q)
-    target = base * Pose.from_array(STANDOFF)
+    base = free.arm.base_pose()
+    q0, seed = np.array(free_q), np.array(plan_q)
+    target = base * Pose.from_array(standoff)
 
     def start() -> None:
-        _place(b, robot, right.arm, np.array(HOLDER_Q))
-        _place(b, robot, left.arm, q0)
-        left.cmd = base * Pose.from_array(GIVER_CMD)
-        st.est = base * Pose.from_array(CUBE)
+        _place(b, robot, hold.arm, np.array(hold_q))
+        _place(b, robot, free.arm, q0)
+        free.cmd = base * Pose.from_array(cmd)
+        st.est = base * Pose.from_array(cube)
         assert arm_contact_forces(b, robot.body, *links) == {}
 
     def contacts() -> list[dict]:
@@ -134,9 +154,9 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_sideways(ma
     points = st._hand_points()
     c = st.est.p
     old = st._plan_detour(
-        left,
+        free,
         target,
-        st.back_off(left.cmd, 0.25 - float(np.linalg.norm(left.cmd.p - c))),
+        st.back_off(free.cmd, 0.25 - float(np.linalg.norm(free.cmd.p - c))),
         st.back_off(target, 0.25 - float(np.linalg.norm(target.p - c))),
         q0,
         seed,
@@ -148,24 +168,26 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_sideways(ma
     assert old is not None
     margin = min(
         float(
-            st.grasp.arm_margin(st, left, a[None] + np.linspace(0, 1, 21)[:, None] * (b_ - a)).min()
+            st.grasp.arm_margin(st, free, a[None] + np.linspace(0, 1, 21)[:, None] * (b_ - a)).min()
         )
         for a, b_ in old.joint_steps()
     )
     assert margin < -0.02
-    st._make_detour(left, old, LABEL, 0.05, clear=0.0, distance=0.25)
+    st._make_detour(free, old, LABEL, 0.05, clear=0.0, distance=0.25)
     pressed = contacts()
     assert pressed and max(e["force_n"] for e in pressed) > 5.0, pressed
-    assert {tuple(e["links"]) for e in pressed} == {("l_elbow_flex_link", "r_elbow_flex_link")}
+    assert {tuple(e["links"]) for e in pressed} == {("l_elbow_flex_link", "r_elbow_flex_link")}, (
+        pressed
+    )
 
-    # the machine's choice from the same start: out sideways, towards the stand-off's side of the cube;
-    # no contact on the way, and the hand at the stand-off
+    # the machine's choice from the same start: out another way, towards the stand-off's side of the
+    # cube; no contact on the way, and the hand at the stand-off
     start()
     n = len(contacts())
-    st.transit(left, target, label=LABEL, seed_q=seed)
+    st.transit(free, target, label=LABEL, seed_q=seed)
     detour = [e for e in ctx.recorder.events if e["kind"] == "detour"][-1]
-    assert detour["way_out"] == "side" and detour["label"] == LABEL
+    assert detour["way_out"] == way and detour["label"] == LABEL
     assert len(contacts()) == n
     assert arm_contact_forces(b, robot.body, *links) == {}
-    reached = base * Pose.from_matrix(left.arm.fk(left.arm.positions()[None])[0])
+    reached = base * Pose.from_matrix(free.arm.fk(free.arm.positions()[None])[0])
     assert np.linalg.norm(reached.p - target.p) < 5e-3

@@ -98,6 +98,14 @@ class Hand:
     log: list = field(default_factory=list)
 
 
+#: a detour's ways out other than back along the hand's approach, in the order tried
+#: (:meth:`BimanualRubiksMachine._way_out`). "side-up" since 2026-12-04: a hand in front of the cube
+#: going to a stand-off at its side, whose way back along the approach met the other arm's elbow and
+#: whose turns from straight up or straight sideways swept the cube (SAPIEN Rubiks-1-50 sensor-aided
+#: seed 0, 1385.6 s; the diagonal clears both)
+WAYS_OUT = ("up", "side", "side-up")
+
+
 @dataclass
 class _Detour:
     """A planned detour of :meth:`BimanualRubiksMachine.transit` (nothing moved yet): the straight way
@@ -1118,10 +1126,9 @@ class BimanualRubiksMachine:
             )
             return
         c = self.est.p
-        r0 = float(np.linalg.norm(hand.cmd.p - c))
         r1 = float(np.linalg.norm(target.p - c))
         for d in cfg.detour_distances:
-            out = self.back_off(hand.cmd, max(0.0, d - r0))
+            out = self._way_out(hand, target, None, d)
             turned = self.back_off(target, max(0.0, d - r1))
             if self._detour(
                 hand,
@@ -1150,14 +1157,9 @@ class BimanualRubiksMachine:
             # way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
             # Rubiks-5-100 trial 3, a hand 13 cm in front of the cube going to a stand-off on its left:
             # only the way out 10-15 cm to the left clears. Both ended `unreachable` here before)
-            side = target.p - c
-            ways = [
-                ("up", np.array([0.0, 0.0, 1.0])),
-                ("side", side / max(np.linalg.norm(side), 1e-9)),
-            ]
-            for name, direction in ways:
+            for name in WAYS_OUT:
                 for d in cfg.detour_distances:
-                    way = Pose(hand.cmd.p + max(0.0, d - r0) * direction, hand.cmd.q)
+                    way = self._way_out(hand, target, name, d)
                     turned = self.back_off(target, max(0.0, d - r1))
                     if self._detour(
                         hand,
@@ -1279,21 +1281,10 @@ class BimanualRubiksMachine:
         margin falls to -44 mm at 25 and 35 cm; sideways towards the stand-off it stays 3.3 mm)."""
         if getattr(self.grasp, "arm_margin", None) is None or not self.config.arm_check:
             return None
-        c = self.est.p
-        r0 = float(np.linalg.norm(hand.cmd.p - c))
-        r1 = float(np.linalg.norm(target.p - c))
-        side = target.p - c
-        ways: list[tuple[str | None, np.ndarray | None]] = [
-            (None, None),
-            ("up", np.array([0.0, 0.0, 1.0])),
-            ("side", side / max(float(np.linalg.norm(side)), 1e-9)),
-        ]
-        for name, direction in ways:
+        r1 = float(np.linalg.norm(target.p - self.est.p))
+        for name in (None, *WAYS_OUT):
             for d in self.config.detour_distances:
-                if direction is None:
-                    out = self.back_off(hand.cmd, max(0.0, d - r0))
-                else:
-                    out = Pose(hand.cmd.p + max(0.0, d - r0) * direction, hand.cmd.q)
+                out = self._way_out(hand, target, name, d)
                 turned = self.back_off(target, max(0.0, d - r1))
                 plan = self._plan_detour(
                     hand, target, out, turned, q0, plan_seed, points, label, name, notes=[]
@@ -1303,6 +1294,28 @@ class BimanualRubiksMachine:
                 ):
                     return d, plan
         return None
+
+    def _way_out(self, hand: Hand, target: Pose, way: str | None, distance: float) -> Pose:
+        """Where a detour's straight way out ends, ``distance`` from the believed cube centre (or where
+        the hand is, if it is farther): back along the hand's approach (``way`` None) or one of
+        :data:`WAYS_OUT` (straight up; towards the stand-off's side of the cube; between those two),
+        the hand's orientation kept."""
+        c = self.est.p
+        r0 = float(np.linalg.norm(hand.cmd.p - c))
+        if way is None:
+            return self.back_off(hand.cmd, max(0.0, distance - r0))
+        side = target.p - c
+        side = side / max(np.linalg.norm(side), 1e-9)
+        up = np.array([0.0, 0.0, 1.0])
+        if way == "up":
+            direction = up
+        elif way == "side":
+            direction = side
+        elif way == "side-up":
+            direction = (side + up) / max(np.linalg.norm(side + up), 1e-9)
+        else:
+            raise ValueError(f"unknown way out {way!r}; expected one of {WAYS_OUT}")
+        return Pose(hand.cmd.p + max(0.0, distance - r0) * direction, hand.cmd.q)
 
     def _make_detour(
         self,
