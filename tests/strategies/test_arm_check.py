@@ -151,20 +151,7 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way
     # the detour the trial took: out along the approach to 25 cm. Clear of the cube, not of the other
     # arm: the model's margin goes below zero and the engine finds the elbows pressing
     start()
-    points = st._hand_points()
-    c = st.est.p
-    old = st._plan_detour(
-        free,
-        target,
-        st.back_off(free.cmd, 0.25 - float(np.linalg.norm(free.cmd.p - c))),
-        st.back_off(target, 0.25 - float(np.linalg.norm(target.p - c))),
-        q0,
-        seed,
-        points,
-        LABEL,
-        None,
-        notes=[],
-    )
+    old = st._plan_detour(free, target, None, 0.25, q0, seed, st._hand_points(), LABEL, notes=[])
     assert old is not None
     margin = min(
         float(
@@ -173,7 +160,7 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way
         for a, b_ in old.joint_steps()
     )
     assert margin < -0.02
-    st._make_detour(free, old, LABEL, 0.05, clear=0.0, distance=0.25)
+    st._make_detour(free, old, LABEL, 0.05, clear=0.0)
     pressed = contacts()
     assert pressed and max(e["force_n"] for e in pressed) > 5.0, pressed
     assert {tuple(e["links"]) for e in pressed} == {("l_elbow_flex_link", "r_elbow_flex_link")}, (

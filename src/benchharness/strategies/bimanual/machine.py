@@ -108,11 +108,12 @@ WAYS_OUT = ("up", "side", "side-up")
 
 @dataclass
 class _Detour:
-    """A planned detour of :meth:`BimanualRubiksMachine.transit` (nothing moved yet): the straight way
-    out (poses with their IK solutions; empty: the turn starts where the hand is), the joint-space turn
+    """A planned detour of :meth:`BimanualRubiksMachine.transit` (nothing moved yet), ``distance`` from
+    the believed cube: the straight way out (poses with their IK solutions; empty: the turn starts where the hand is), the joint-space turn
     to ``turned`` (solution ``qb``), the straight way in, which way out (None: along the approach), and
     the ``arm_avoid`` events its planning kept back."""
 
+    distance: float
     q0: np.ndarray
     leg_out: list[tuple[Pose, np.ndarray]]
     turned: Pose
@@ -1119,32 +1120,12 @@ class BimanualRubiksMachine:
             self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
         clear = self.sweep_clearance(hand, q0, q1, points)
-        apart = self._arm_clear_detour(hand, target, q0, plan_seed, points, label)
-        if apart is not None:
-            self._make_detour(
-                hand, apart[1], label, settle, clear=clear, distance=apart[0], branch_change=detour
-            )
+        plan = self._arm_clear_detour(hand, target, q0, plan_seed, points, label)
+        if plan is None:
+            plan = self._first_detour(hand, target, (None,), q0, plan_seed, points, label)
+        if plan is not None:
+            self._make_detour(hand, plan, label, settle, clear=clear, branch_change=detour)
             return
-        c = self.est.p
-        r1 = float(np.linalg.norm(target.p - c))
-        for d in cfg.detour_distances:
-            out = self._way_out(hand, target, None, d)
-            turned = self.back_off(target, max(0.0, d - r1))
-            if self._detour(
-                hand,
-                target,
-                out,
-                turned,
-                q0,
-                plan_seed,
-                points,
-                label,
-                settle,
-                clear=clear,
-                distance=d,
-                branch_change=detour,
-            ):
-                return
         start = self.sweep_clearance(hand, q0, q0, points, n=1)
         if detour and clear >= min(cfg.sweep_clearance, start):  # no detour, but the move clears
             self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
@@ -1157,25 +1138,10 @@ class BimanualRubiksMachine:
             # way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
             # Rubiks-5-100 trial 3, a hand 13 cm in front of the cube going to a stand-off on its left:
             # only the way out 10-15 cm to the left clears. Both ended `unreachable` here before)
-            for name in WAYS_OUT:
-                for d in cfg.detour_distances:
-                    way = self._way_out(hand, target, name, d)
-                    turned = self.back_off(target, max(0.0, d - r1))
-                    if self._detour(
-                        hand,
-                        target,
-                        way,
-                        turned,
-                        q0,
-                        plan_seed,
-                        points,
-                        label,
-                        settle,
-                        clear=clear,
-                        distance=d,
-                        way_out=name,
-                    ):
-                        return
+            plan = self._first_detour(hand, target, WAYS_OUT, q0, plan_seed, points, label)
+            if plan is not None:
+                self._make_detour(hand, plan, label, settle, clear=clear)
+                return
             # nothing goes round: the move would knock the cube, so the trial ends here with that
             # cause. Made anyway, it put the open hand through the cube (measured: SAPIEN Rubiks-5-200
             # dead reckoning seed 0
@@ -1193,52 +1159,28 @@ class BimanualRubiksMachine:
         )
         self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
 
-    def _detour(
-        self,
-        hand: Hand,
-        target: Pose,
-        out: Pose,
-        turned: Pose,
-        q0: np.ndarray,
-        plan_seed: np.ndarray,
-        points: np.ndarray,
-        label: str,
-        settle: float,
-        *,
-        clear: float,
-        distance: float,
-        branch_change: bool = False,
-        way_out: str | None = None,
-    ) -> bool:
-        """One detour of :meth:`transit`, made if every leg is clear of the cube (:meth:`_plan_detour`);
-        False (nothing moved) if a leg is not. ``clear`` (the direct move's clearance) and ``distance``
-        are recorded in the ``detour`` event."""
-        plan = self._plan_detour(hand, target, out, turned, q0, plan_seed, points, label, way_out)
-        if plan is None:
-            return False
-        self._make_detour(
-            hand, plan, label, settle, clear=clear, distance=distance, branch_change=branch_change
-        )
-        return True
-
     def _plan_detour(
         self,
         hand: Hand,
         target: Pose,
-        out: Pose,
-        turned: Pose,
+        way_out: str | None,
+        distance: float,
         q0: np.ndarray,
         plan_seed: np.ndarray,
         points: np.ndarray,
         label: str,
-        way_out: str | None,
         notes: list[dict] | None = None,
     ) -> _Detour | None:
-        """A detour's legs, each clear of the believed cube, or None: straight out from the command to
-        ``out``, a joint-space turn to ``turned`` (the target backed off along its approach), straight in
-        to ``target``. The way out along the approach (``way_out`` None) that is not clear is left out
-        and the turn is checked from where the hand is; another way out (``way_out`` names it) must be
-        clear. Nothing moves; ``notes`` as for :meth:`_line`."""
+        """A detour of :meth:`transit` ``distance`` from the believed cube, its legs each clear of the
+        cube, or None: straight out from the command by ``way_out`` (:meth:`_way_out`), a joint-space
+        turn to the target backed off along its approach to ``distance``, straight in to ``target``.
+        The way out along the approach (``way_out`` None) that is not clear is left out and the turn is
+        checked from where the hand is; another way out must be clear. Nothing moves; the legs'
+        ``arm_avoid`` events are recorded now, or kept in ``notes`` if given (:meth:`_line`)."""
+        out = self._way_out(hand, target, way_out, distance)
+        turned = self.back_off(
+            target, max(0.0, distance - float(np.linalg.norm(target.p - self.est.p)))
+        )
         leg_out = self._line(hand, hand.cmd, out, q0, points, f"{label} detour out", notes=notes)
         if leg_out is None:
             if way_out is not None:
@@ -1255,7 +1197,8 @@ class BimanualRubiksMachine:
         leg_in = self._line(hand, turned, target, qb, points, f"{label} detour in", notes=notes)
         if leg_in is None:
             return None
-        return _Detour(q0, leg_out, turned, qb, leg_in, way_out, [] if notes is None else notes)
+        notes = [] if notes is None else notes
+        return _Detour(distance, q0, leg_out, turned, qb, leg_in, way_out, notes)
 
     def _arm_clear_detour(
         self,
@@ -1265,8 +1208,8 @@ class BimanualRubiksMachine:
         plan_seed: np.ndarray,
         points: np.ndarray,
         label: str,
-    ) -> tuple[float, _Detour] | None:
-        """The first detour (and its distance) whose every leg is clear of the cube *and* keeps the arm
+    ) -> _Detour | None:
+        """The first detour whose every leg is clear of the cube *and* keeps the arm
         clear of the other arm (:meth:`_arm_clears` on each step's joint path, the turn's included): out
         along the approach at each of ``detour_distances``, then straight up, then towards the stand-off's
         side of the cube. None without the grasp module's ``arm_margin``, with ``arm_check`` off, or if no
@@ -1281,18 +1224,32 @@ class BimanualRubiksMachine:
         margin falls to -44 mm at 25 and 35 cm; sideways towards the stand-off it stays 3.3 mm)."""
         if getattr(self.grasp, "arm_margin", None) is None or not self.config.arm_check:
             return None
-        r1 = float(np.linalg.norm(target.p - self.est.p))
-        for name in (None, *WAYS_OUT):
+        ways = (None, *WAYS_OUT)
+        return self._first_detour(hand, target, ways, q0, plan_seed, points, label, arm_clear=True)
+
+    def _first_detour(
+        self,
+        hand: Hand,
+        target: Pose,
+        ways: tuple[str | None, ...],
+        q0: np.ndarray,
+        plan_seed: np.ndarray,
+        points: np.ndarray,
+        label: str,
+        arm_clear: bool = False,
+    ) -> _Detour | None:
+        """The first detour (:meth:`_plan_detour`) by each of ``ways`` at each of ``detour_distances`` in
+        turn that is clear of the cube and, with ``arm_clear``, keeps the arm clear of the other arm on
+        every joint path (its ``arm_avoid`` events kept with it, not recorded); None if none is."""
+        for name in ways:
             for d in self.config.detour_distances:
-                out = self._way_out(hand, target, name, d)
-                turned = self.back_off(target, max(0.0, d - r1))
-                plan = self._plan_detour(
-                    hand, target, out, turned, q0, plan_seed, points, label, name, notes=[]
-                )
-                if plan is not None and all(
-                    self._arm_clears(hand, a, b) for a, b in plan.joint_steps()
+                notes: list[dict] | None = [] if arm_clear else None
+                plan = self._plan_detour(hand, target, name, d, q0, plan_seed, points, label, notes)
+                if plan is not None and (
+                    not arm_clear
+                    or all(self._arm_clears(hand, a, b) for a, b in plan.joint_steps())
                 ):
-                    return d, plan
+                    return plan
         return None
 
     def _way_out(self, hand: Hand, target: Pose, way: str | None, distance: float) -> Pose:
@@ -1325,10 +1282,10 @@ class BimanualRubiksMachine:
         settle: float,
         *,
         clear: float,
-        distance: float,
         branch_change: bool = False,
     ) -> None:
-        """Make a planned detour: its kept ``arm_avoid`` events, the ``detour`` event, then the moves."""
+        """Make a planned detour: its kept ``arm_avoid`` events, the ``detour`` event (with ``clear``,
+        the direct move's clearance), then the moves."""
         cfg = self.config
         for note in plan.notes:
             self.ctx.recorder.event("arm_avoid", **note)
@@ -1337,7 +1294,7 @@ class BimanualRubiksMachine:
             hand=hand.side,
             label=label,
             clearance_mm=round(1000 * clear, 1),
-            distance_m=distance,
+            distance_m=plan.distance,
             straight_out=bool(plan.leg_out),
             **({"branch_change": True} if branch_change else {}),
             **({"way_out": plan.way_out} if plan.way_out is not None else {}),
