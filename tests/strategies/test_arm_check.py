@@ -11,7 +11,8 @@ stays apart with the same joint error added.
 The other cases are detours (``DETOURS``, two trials): a giver in front of the cube backing out along its
 approach on its way to a stand-off at the cube's side put its elbow on the holding arm's (50-67 N in
 the trials, as much here). No elbow posture keeps that way out clear; the machine goes out another way
-(sideways, or sideways and up), and the engines find no contact.
+(sideways, or sideways and up), and the engines find no contact. The last case is a detour's way out
+for an open hand still round the cube (``SLIDE``): it slides along its pads' faces.
 """
 
 from __future__ import annotations
@@ -176,5 +177,53 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way
     assert detour["way_out"] == way and detour["label"] == LABEL
     assert len(contacts()) == n
     assert arm_contact_forces(b, robot.body, *links) == {}
+    reached = base * Pose.from_matrix(free.arm.fk(free.arm.positions()[None])[0])
+    assert np.linalg.norm(reached.p - target.p) < 5e-3
+
+
+#: a giver above the cube whose retreat was cut to 2 cm (the way up left the arm's branch), bound for a
+#: re-grip stand-off at the cube's -y side, recorded at 2506.65 s of SAPIEN Rubiks-1-100 sensor-aided
+#: seed 0 at 0361275 (the layout of ``DETOURS``): no way out but sliding along the pads' faces cleared
+#: the cube, and that trial ended ``unreachable``
+SLIDE = (
+    "right",
+    [0.042293, -0.331408, -2.55587, -1.227067, -0.727882, -0.894567, 54.16156],
+    [0.297207, 0.143106, 2.43198, -1.042332, -0.885782, -1.119938, -25.792177],
+    [0.650515, 0.002787, -0.252557, -0.0044, 0.710218, -0.002635, 0.703963],
+    [0.656226, -0.171834, -0.290346, 0.702667, 0.711518, -0.000376, 0.000841],
+    [0.653975, 0.007982, -0.290656, -0.707701, -0.004658, 0.004193, 0.706484],
+    [-0.408418, 0.343384, -1.961886, -0.98987, 0.26329, -1.001675, 54.365301],
+)
+
+
+@pytest.mark.parametrize("backend", ("pybullet", "sapien"))
+def test_an_open_hand_round_the_cube_with_no_way_up_slides_out_along_its_pads(make_ctx, backend):
+    from benchharness.strategies.bimanual.machine import WAYS_OUT
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
+
+    ctx, b = make_ctx(backend, "R")
+    st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
+    assert st.run_trial(ctx).failure is None
+    side, free_q, hold_q, cmd, standoff, cube, plan_q = SLIDE
+    free, hold = st.hands[side], st.other(st.hands[side])
+    _place(b, ctx.robot, hold.arm, np.array(hold_q))
+    _place(b, ctx.robot, free.arm, np.array(free_q))
+    base = free.arm.base_pose()
+    free.cmd = base * Pose.from_array(cmd)
+    st.est = base * Pose.from_array(cube)
+    target = base * Pose.from_array(standoff)
+    q0, seed, points = free.arm.positions(), np.array(plan_q), st._hand_points()
+
+    # the hand points down at the cube's top, 38 mm above its centre, pads on its +-y faces: straight up
+    # (its approach) takes another arm branch, every world-frame way out drags a pad through the cube
+    assert free.cmd.rotation.apply([1.0, 0.0, 0.0])[2] < -0.99
+    for way in (None, "up", "side", "side-up"):
+        assert st._first_detour(free, target, (way,), q0, seed, points, LABEL) is None, way
+    assert WAYS_OUT[-2:] == ("slide+", "slide-")
+
+    st.transit(free, target, label=LABEL, seed_q=seed)
+    detour = [e for e in ctx.recorder.events if e["kind"] == "detour"][-1]
+    assert detour["way_out"] == "slide-" and detour["label"] == LABEL
     reached = base * Pose.from_matrix(free.arm.fk(free.arm.positions()[None])[0])
     assert np.linalg.norm(reached.p - target.p) < 5e-3

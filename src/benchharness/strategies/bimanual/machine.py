@@ -102,8 +102,13 @@ class Hand:
 #: (:meth:`BimanualRubiksMachine._way_out`). "side-up" since 2026-12-04: a hand in front of the cube
 #: going to a stand-off at its side, whose way back along the approach met the other arm's elbow and
 #: whose turns from straight up or straight sideways swept the cube (SAPIEN Rubiks-1-50 sensor-aided
-#: seed 0, 1385.6 s; the diagonal clears both)
-WAYS_OUT = ("up", "side", "side-up")
+#: seed 0, 1385.6 s; the diagonal clears both). "slide+" / "slide-" (the same day): along the hand's own
+#: axis across its approach and finger axes, either way, so that open pads still round the cube slide
+#: along the faces they were on, as a sideways retreat does: a giver above the cube whose retreat was cut
+#: to 2 cm (the way up left the arm's branch, a 0.61 rad step) had no other way out that cleared the
+#: cube, and the trial ended ``unreachable`` (SAPIEN Rubiks-1-100 sensor-aided seed 0 at 0361275,
+#: 2506.7 s, after 84 moves)
+WAYS_OUT = ("up", "side", "side-up", "slide+", "slide-")
 
 
 @dataclass
@@ -1255,8 +1260,9 @@ class BimanualRubiksMachine:
     def _way_out(self, hand: Hand, target: Pose, way: str | None, distance: float) -> Pose:
         """Where a detour's straight way out ends, ``distance`` from the believed cube centre (or where
         the hand is, if it is farther): back along the hand's approach (``way`` None) or one of
-        :data:`WAYS_OUT` (straight up; towards the stand-off's side of the cube; between those two),
-        the hand's orientation kept."""
+        :data:`WAYS_OUT` (straight up; towards the stand-off's side of the cube; between those two;
+        along the hand's axis across its approach and finger axes, either way), the hand's orientation
+        kept."""
         c = self.est.p
         r0 = float(np.linalg.norm(hand.cmd.p - c))
         if way is None:
@@ -1270,6 +1276,10 @@ class BimanualRubiksMachine:
             direction = side
         elif way == "side-up":
             direction = (side + up) / max(np.linalg.norm(side + up), 1e-9)
+        elif way in ("slide+", "slide-"):
+            axis = 3 - self.grasp.approach_axis - self.grasp.finger_axis
+            sign = 1.0 if way == "slide+" else -1.0
+            direction = hand.cmd.rotation.apply(along(axis, sign))
         else:
             raise ValueError(f"unknown way out {way!r}; expected one of {WAYS_OUT}")
         return Pose(hand.cmd.p + max(0.0, distance - r0) * direction, hand.cmd.q)
