@@ -1137,8 +1137,8 @@ class BimanualRubiksMachine:
             return
         if clear <= 0.0 < start:
             # the straight path enters the believed cube (or the table) and no detour out along the
-            # approach goes round: the way out straight up, then towards the stand-off's side of the
-            # cube (measured: PyBullet Rubiks-5-10 sensor-aided seed 0 trial 3, a giver that had
+            # approach goes round: the other ways out (``WAYS_OUT``: straight up, then towards the
+            # stand-off's side of the cube, ...; measured: PyBullet Rubiks-5-10 sensor-aided seed 0 trial 3, a giver that had
             # retreated sideways in front of the cube, its wrist flex on its soft limit, had no straight
             # way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
             # Rubiks-5-100 trial 3, a hand 13 cm in front of the cube going to a stand-off on its left:
