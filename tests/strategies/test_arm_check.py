@@ -154,11 +154,14 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way
     start()
     old = st._plan_detour(free, target, None, 0.25, q0, seed, st._hand_points(), LABEL, notes=[])
     assert old is not None
+    outs = [q0, *(q for _, q in old.leg_out)]
+    ins = [old.qb, *(q for _, q in old.leg_in)]
+    steps = [*zip(outs[:-1], outs[1:]), (old.qa, old.qb), *zip(ins[:-1], ins[1:])]
     margin = min(
         float(
             st.grasp.arm_margin(st, free, a[None] + np.linspace(0, 1, 21)[:, None] * (b_ - a)).min()
         )
-        for a, b_ in old.joint_steps()
+        for a, b_ in steps
     )
     assert margin < -0.02
     st._make_detour(free, old, LABEL, 0.05, clear=0.0)

@@ -70,12 +70,12 @@ class BimanualConfig:
     #: (:meth:`.machine.BimanualRubiksMachine.smooth_q`: a retreat's straight way out and its 2 cm steps,
     #: a sideways retreat's steps, the pre-touch sweeps; and, as a preference only, a detour's straight
     #: legs; a detour whose legs and turn all keep clear is taken before any that does not, its way out
-    #: along the approach, up or sideways: ``transit``) must keep the arm clear of the other arm on its
-    #: joint path (margin >= 0 all the way; an arm that starts nearer, never nearer than it starts). The
-    #: nearest IK solution that does not is replaced
-    #: by the clear one of least joint change among those solved from the arm's joints with each joint
-    #: moved by each of ``arm_check_offsets`` either way (the 7-DOF arm's elbow swings about the
-    #: shoulder-wrist line while the hand keeps its pose); an ``arm_avoid`` event records it. With none,
+    #: along the approach or any of ``machine.WAYS_OUT``: ``transit``) must keep the arm clear of the
+    #: other arm on its joint path (margin >= 0 all the way; an arm that starts nearer, never nearer than
+    #: it starts). The nearest IK solution that does not is replaced by the clear one of least joint
+    #: change among those solved from the arm's joints with each joint moved by each of
+    #: ``arm_check_offsets`` either way (the 7-DOF arm's elbow swings about the shoulder-wrist line while
+    #: the hand keeps its pose); an ``arm_avoid`` event records it. With none,
     #: the move counts as one the arm cannot make smoothly (a retreat goes sideways or is cut, a sweep is
     #: skipped), except a detour's step, made as before (the event says ``found: false``: refusing it
     #: ended SAPIEN Rubiks-1-50 ``unreachable`` where the move, elbows touching, had been harmless). Moves

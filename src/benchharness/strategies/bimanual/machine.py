@@ -114,24 +114,19 @@ WAYS_OUT = ("up", "side", "side-up", "slide+", "slide-")
 @dataclass
 class _Detour:
     """A planned detour of :meth:`BimanualRubiksMachine.transit` (nothing moved yet), ``distance`` from
-    the believed cube: the straight way out (poses with their IK solutions; empty: the turn starts where the hand is), the joint-space turn
-    to ``turned`` (solution ``qb``), the straight way in, which way out (None: along the approach), and
-    the ``arm_avoid`` events its planning kept back."""
+    the believed cube: the straight way out (poses with their IK solutions; empty: none, the turn starts
+    where the hand is), the joint-space turn from ``qa`` to ``turned`` (solution ``qb``), the straight
+    way in, which way out (None: along the approach), and the ``arm_avoid`` events its planning kept
+    back."""
 
     distance: float
-    q0: np.ndarray
     leg_out: list[tuple[Pose, np.ndarray]]
+    qa: np.ndarray
     turned: Pose
     qb: np.ndarray
     leg_in: list[tuple[Pose, np.ndarray]]
     way_out: str | None
     notes: list[dict]
-
-    def joint_steps(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        """Every straight joint-space path the detour makes, in order (out, turn, in)."""
-        qs = [self.q0, *(q for _, q in self.leg_out), self.qb]
-        ins = [self.qb, *(q for _, q in self.leg_in)]
-        return list(zip(qs[:-1], qs[1:], strict=True)) + list(zip(ins[:-1], ins[1:], strict=True))
 
 
 def _shifted(pose: Pose, shift: np.ndarray) -> Pose:
@@ -213,7 +208,8 @@ class GraspModule(Protocol):
     Optional: ``arm_margin(m, hand, q) -> np.ndarray``: how far (m) ``hand``'s arm at each row of joints
     ``q`` stays beyond the robot's required clearance from the other arm where it is (negative: nearer);
     with it the moves solved from the arm's joints (retreats, the pre-touch sweeps; a detour's straight
-    legs as a preference) keep the arms apart (``arm_check``). A module without it is not checked.
+    legs as a preference, and the choice of a detour's way out) keep the arms apart (``arm_check``). A
+    module without it is not checked.
 
     Optional: ``roll_offset(m, hand) -> float | None``: where the gripped layer's axis lies from the
     rotator's approach axis along its finger axis (m), as the hand's own closed fingers measure it (None:
@@ -1101,8 +1097,9 @@ class BimanualRubiksMachine:
         orientation and the straight way back in (in 2 cm steps) stay clear (where the
         straight way out is not clear, the swing is checked from where the hand is), and
         a ``detour`` event is recorded. With the arm check (``arm_check``, the grasp module's
-        ``arm_margin``) a detour that also keeps the arm clear of the other arm, out along the approach,
-        up or sideways, comes first (:meth:`_arm_clear_detour`). If none does, the direct move is made and
+        ``arm_margin``) a detour that also keeps the arm clear of the other arm, out along the approach
+        or any of :data:`WAYS_OUT`, comes first (:meth:`_arm_clear_detour`). If none does, the direct
+        move is made and
         a warning recorded, unless its path enters the believed cube or the table from a start
         outside them: then the trial ends ``unreachable`` (the move would knock the cube).
 
@@ -1138,8 +1135,8 @@ class BimanualRubiksMachine:
         if clear <= 0.0 < start:
             # the straight path enters the believed cube (or the table) and no detour out along the
             # approach goes round: the other ways out (``WAYS_OUT``: straight up, then towards the
-            # stand-off's side of the cube, ...; measured: PyBullet Rubiks-5-10 sensor-aided seed 0 trial 3, a giver that had
-            # retreated sideways in front of the cube, its wrist flex on its soft limit, had no straight
+            # stand-off's side of the cube, ...; measured: PyBullet Rubiks-5-10 sensor-aided seed 0
+            # trial 3, a giver that had retreated sideways in front of the cube, its wrist flex on its soft limit, had no straight
             # way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
             # Rubiks-5-100 trial 3, a hand 13 cm in front of the cube going to a stand-off on its left:
             # only the way out 10-15 cm to the left clears. Both ended `unreachable` here before)
@@ -1203,7 +1200,7 @@ class BimanualRubiksMachine:
         if leg_in is None:
             return None
         notes = [] if notes is None else notes
-        return _Detour(distance, q0, leg_out, turned, qb, leg_in, way_out, notes)
+        return _Detour(distance, leg_out, qa, turned, qb, leg_in, way_out, notes)
 
     def _arm_clear_detour(
         self,
@@ -1214,10 +1211,9 @@ class BimanualRubiksMachine:
         points: np.ndarray,
         label: str,
     ) -> _Detour | None:
-        """The first detour whose every leg is clear of the cube *and* keeps the arm
-        clear of the other arm (:meth:`_arm_clears` on each step's joint path, the turn's included): out
-        along the approach at each of ``detour_distances``, then straight up, then towards the stand-off's
-        side of the cube. None without the grasp module's ``arm_margin``, with ``arm_check`` off, or if no
+        """The first detour whose every leg is clear of the cube *and* keeps the arm clear of the other
+        arm (:meth:`_arm_clears` on each step's joint path, the turn's included): out along the approach
+        at each of ``detour_distances``, then each of :data:`WAYS_OUT` in turn. None without the grasp module's ``arm_margin``, with ``arm_check`` off, or if no
         detour is clear of both; :meth:`transit` then takes its detour as before. Nothing moves and no
         event is recorded here.
 
@@ -1245,14 +1241,19 @@ class BimanualRubiksMachine:
     ) -> _Detour | None:
         """The first detour (:meth:`_plan_detour`) by each of ``ways`` at each of ``detour_distances`` in
         turn that is clear of the cube and, with ``arm_clear``, keeps the arm clear of the other arm on
-        every joint path (its ``arm_avoid`` events kept with it, not recorded); None if none is."""
+        every joint path (its ``arm_avoid`` events kept with it, not recorded); None if none is. The
+        straight legs' steps were checked as they were planned (:meth:`_line`: a step with no clear
+        posture is a ``found: false`` note), so only the turn is checked here."""
         for name in ways:
             for d in self.config.detour_distances:
                 notes: list[dict] | None = [] if arm_clear else None
                 plan = self._plan_detour(hand, target, name, d, q0, plan_seed, points, label, notes)
                 if plan is not None and (
                     not arm_clear
-                    or all(self._arm_clears(hand, a, b) for a, b in plan.joint_steps())
+                    or (
+                        all(n.get("found", True) for n in plan.notes)
+                        and self._arm_clears(hand, plan.qa, plan.qb)
+                    )
                 ):
                     return plan
         return None
