@@ -304,6 +304,22 @@ class RobotArm:
         return self.robot.joint_positions(self.joints)
 
     # -- motion primitives -----------------------------------------------------------
+    def solve_pose(
+        self,
+        target: Pose,
+        *,
+        generator: UniformStream | torch.Generator | None = None,
+        seed: int = 0,
+        seed_q: np.ndarray | None = None,
+    ) -> IKResult:
+        """The IK solution (one row) :meth:`move_to_pose` would move to for the world pose ``target``:
+        seeded with the current joints or ``seed_q``. Solved apart so a caller can judge the joints
+        before the arm moves and hand them on (``move_to_pose(solution=...)``)."""
+        base = self.base_pose()
+        local = (base.inv() * target).as_matrix()
+        q_now = self.positions() if seed_q is None else np.asarray(seed_q, dtype=float)
+        return self.ik(local[None], seed_q=q_now, generator=generator, seed=seed)
+
     def move_to_pose(
         self,
         target: Pose,
@@ -315,6 +331,7 @@ class RobotArm:
         seed: int = 0,
         seed_q: np.ndarray | None = None,
         move_unsolved: bool = True,
+        solution: IKResult | None = None,
     ) -> MotionResult:
         """Move the tool frame to a world pose: IK for the goal, then a tracked joint trajectory.
 
@@ -328,11 +345,15 @@ class RobotArm:
         default the arm moves to the IK's best attempt, which for a target just out of reach can be
         a random restart on another arm branch (measured: upper-arm and forearm rolls swung -2.84 /
         +2.86 rad for a target 2 mm out of reach, PR2 on SAPIEN).
+
+        ``solution``: the IK of ``target`` already solved (:meth:`solve_pose`, possibly replaced by
+        the caller with another solution of the same target); the seeds are then not used.
         """
-        base = self.base_pose()
-        local = (base.inv() * target).as_matrix()
-        q_now = self.positions() if seed_q is None else np.asarray(seed_q, dtype=float)
-        res = self.ik(local[None], seed_q=q_now, generator=generator, seed=seed)
+        res = (
+            solution
+            if solution is not None
+            else self.solve_pose(target, generator=generator, seed=seed, seed_q=seed_q)
+        )
         if not move_unsolved and not res.success[0]:
             return MotionResult(
                 False,

@@ -32,6 +32,7 @@ from scipy.spatial.transform import Rotation
 
 from ...backends.interface import Backend, BodyId, Box, CameraSpec
 from ...geometry import Pose
+from ...robots.kinematics import IKResult
 from ...runner.contract import RubiksItem, TrialContext, TrialOutcome
 from ..regrasp import (
     HandModel,
@@ -573,13 +574,15 @@ class BimanualRubiksMachine:
         swung the upper-arm and forearm rolls -2.84 / +2.86 rad into the cube held by the other hand
         alone, 72 N; the sweep, which catches the failure and skips, had already moved)."""
         slack = max((v for v in (self.config.ik_slack, slack) if v is not None), default=None)
+        sent = self.actual(hand, target, self.noise())
         res = hand.arm.move_to_pose(
-            self.actual(hand, target, self.noise()),
+            sent,
             duration=duration,
             velocity_scale=self.config.velocity_scale,
             settle=settle,
             seed_q=seed_q,
             move_unsolved=slack is not None,
+            solution=self._sent_solution(hand, sent, seed_q, label),
         )
         if not res.ik_success and slack is None:
             if skip_unreached:
@@ -618,6 +621,45 @@ class BimanualRubiksMachine:
             self.est = target * hand.cube_in_tcp  # dead reckoning: the cube moved with the command
         self._arm_contact(hand, label)
         return True
+
+    def _sent_solution(
+        self, hand: Hand, sent: Pose, seed_q: np.ndarray | None, label: str
+    ) -> IKResult | None:
+        """The joints the arm moves to for the target it is ``sent`` (the injected errors in it), judged
+        against the other arm before it moves (with ``arm_check`` and the grasp module's
+        ``arm_margin``; else None: :meth:`RobotArm.move_to_pose` solves as it always did).
+
+        Why: the planner checks the joints it solved for the *believed* target, but the arm solves the
+        sent target again, and the 7-DOF arm's elbow can settle elsewhere along its self-motion
+        (measured, SAPIEN Rubiks-1-20 at c26a79a, 536.8 s: a retreat whose planned posture was clear
+        ended with the elbows pressing 35.5 N, the capsule model putting them 1.3 mm into each other).
+        Moves planned without a check (a hand-over take's approach) are judged here too. Where the
+        solved path does not keep the arm clear (:meth:`_arm_clears`) the clear solution of the same
+        target with least joint change is taken instead (an ``arm_avoid`` event, its label ending
+        "as sent"); where there is none, the solved one (the event says ``found: false``). A path
+        that is clear is moved exactly as before: the check draws no random number."""
+        if getattr(self.grasp, "arm_margin", None) is None or not self.config.arm_check:
+            return None
+        sol = hand.arm.solve_pose(sent, seed_q=seed_q)
+        if not bool(sol.success[0]):
+            return sol
+        q = hand.arm.positions()
+        q1 = np.asarray(sol.q[0], dtype=float)
+        if self._arm_clears(hand, q, q1):
+            return sol
+        row = self._arm_clear_row(hand, sent, q)
+        self.ctx.recorder.event(
+            "arm_avoid",
+            hand=hand.side,
+            label=f"{label} as sent",
+            nearest_change=round(float(np.max(np.abs(q1 - q))), 2),
+            **(
+                {"joint_change": round(float(np.max(np.abs(row.q[0] - q))), 2)}
+                if row is not None
+                else {"found": False}
+            ),
+        )
+        return sol if row is None else row
 
     def _arm_contact(self, hand: Hand, label: str) -> None:
         """An ``arm_contact`` event where the arms press on each other after ``hand``'s move to
@@ -1019,6 +1061,11 @@ class BimanualRubiksMachine:
         ``arm_check_offsets`` either way (one batched call; no random draw, so a trial's plan draws are
         untouched) that are smooth (``max_waypoint_jump`` from ``q``) and :meth:`_arm_clears`, the one of
         least joint change (the first seed on a tie); None if none is."""
+        row = self._arm_clear_row(hand, target, q)
+        return None if row is None else np.asarray(row.q[0], dtype=float)
+
+    def _arm_clear_row(self, hand: Hand, target: Pose, q: np.ndarray) -> IKResult | None:
+        """:meth:`_arm_clear_solution` as a one-row IK result (with its IK errors), or None."""
         offsets = self.config.arm_check_offsets
         if not offsets:
             return None
@@ -1033,7 +1080,7 @@ class BimanualRubiksMachine:
         base = hand.arm.base_pose()
         row = (base.inv() * target).as_matrix()
         res = hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
-        best: tuple[float, np.ndarray] | None = None
+        best: tuple[float, int] | None = None
         for i in np.flatnonzero(np.asarray(res.success, dtype=bool)):
             q1 = np.asarray(res.q[i], dtype=float)
             change = float(np.max(np.abs(q1 - q)))
@@ -1042,8 +1089,13 @@ class BimanualRubiksMachine:
                 and (best is None or change < best[0])
                 and self._arm_clears(hand, q, q1)
             ):
-                best = (change, q1)
-        return None if best is None else best[1]
+                best = (change, int(i))
+        if best is None:
+            return None
+        k = slice(best[1], best[1] + 1)
+        return IKResult(
+            np.asarray(res.q[k], dtype=float), res.success[k], res.pos_error[k], res.rot_error[k]
+        )
 
     def _line(
         self,
