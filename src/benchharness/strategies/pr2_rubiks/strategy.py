@@ -66,14 +66,20 @@ def _arm_points(hand: Hand, q: np.ndarray) -> np.ndarray:
     return np.einsum("ij,bpj->bpi", w[:3, :3], pts) + w[:3, 3]
 
 
-def arm_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
-    """Least distance (m) between ``hand``'s arm at each row of ``q`` and the other arm where it is, both
-    as ``ARM_RADIUS`` round their axes (inf: no joint-origin model)."""
+def arm_pair_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
+    """Distance (m) between each point of ``hand``'s arm axis at each row of ``q`` and each of the other
+    arm's where it is, both arms as ``ARM_RADIUS`` round their axes: (B, 13 * 13)."""
     mine = _arm_points(hand, q)
     other = m.other(hand)
     theirs = _arm_points(other, other.arm.positions())
     d = np.linalg.norm(mine[:, :, None, :] - theirs[0][None, None, :, :], axis=-1)
-    return d.min(axis=(1, 2)) - 2 * ARM_RADIUS
+    return d.reshape(len(d), -1) - 2 * ARM_RADIUS
+
+
+def arm_clearance(m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
+    """Least distance (m) between ``hand``'s arm at each row of ``q`` and the other arm where it is, both
+    as ``ARM_RADIUS`` round their axes."""
+    return arm_pair_clearance(m, hand, q).min(axis=1)
 
 
 @functools.cache
@@ -135,10 +141,11 @@ class PR2Grasp:
         return _open_hand_points()
 
     def arm_margin(self, m: BimanualRubiksMachine, hand: Hand, q: np.ndarray) -> np.ndarray:
-        """How far (m) the arm at each row of ``q`` stays beyond ``arm_clearance`` from the other arm where
-        it is, both modelled as ``ARM_RADIUS`` round their axes (:func:`arm_clearance`): the machine keeps
-        the moves it solves from the arm's joints from bringing it below 0 (``arm_check``)."""
-        return arm_clearance(m, hand, np.atleast_2d(q)) - self.config.arm_clearance
+        """How far (m) each part of the arm at each row of ``q`` stays beyond ``arm_clearance`` from each
+        part of the other arm where it is, both modelled as ``ARM_RADIUS`` round their axes
+        (:func:`arm_pair_clearance`; one column per pair of axis points): the machine keeps the moves it
+        solves from the arm's joints from bringing a pair below 0 (``arm_check``)."""
+        return arm_pair_clearance(m, hand, np.atleast_2d(q)) - self.config.arm_clearance
 
     def take_relation(self) -> str | None:
         # in a hand-over the giver's finger lies on the face the taker comes to: only crossing fingers pass it
