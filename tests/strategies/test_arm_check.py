@@ -230,3 +230,72 @@ def test_an_open_hand_round_the_cube_with_no_way_up_slides_out_along_its_pads(ma
     assert detour["way_out"] == "slide-" and detour["label"] == LABEL
     reached = base * Pose.from_matrix(free.arm.fk(free.arm.positions()[None])[0])
     assert np.linalg.norm(reached.p - target.p) < 5e-3
+
+
+#: a giver's 12 cm retreat after a hand-over, recorded at 535.94 s of SAPIEN Rubiks-1-20 sensor-aided
+#: seed 0 at f8d49ca (35.5 N in that trial): the left arm's joints, the right (holding) arm's, the left
+#: tool's last grip and the believed cube (the left arm's base frame, x, y, z, qx, qy, qz, qw), and the
+#: retreat's joints the check on the arm's least margin chose there (the nearest solution's elbow
+#: swung: an ``arm_avoid`` event)
+RETREAT = (
+    [-0.447654, -0.063778, 3.219257, -1.647454, 2.67796, -1.54581, -9.51978],
+    [0.161442, 0.063671, -3.546879, -1.042551, -4.380783, -1.824377, 11.570182],
+    [0.637731, -0.00037, -0.292028, -0.999885, -0.013871, -0.001582, -0.005914],
+    [0.648621, 0.000908, -0.291782, 0.715545, 0.016253, 0.698357, 0.00536],
+    [-0.447511, -0.017339, 3.037463, -1.938622, 2.632132, -1.931101, -9.5125],
+)
+
+
+@pytest.mark.parametrize("backend", ("pybullet", "sapien"))
+def test_a_retreat_is_judged_per_pair_of_arm_parts_and_keeps_the_elbows_apart(make_ctx, backend):
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
+
+    ctx, b = make_ctx(backend, "R")
+    st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
+    assert st.run_trial(ctx).failure is None
+    robot = ctx.robot
+    left, right = st.hands["left"], st.hands["right"]
+    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
+    left_q, right_q, grip, cube, chosen = RETREAT
+    q0 = np.array(left_q)
+
+    def start() -> None:
+        _place(b, robot, right.arm, np.array(right_q))
+        _place(b, robot, left.arm, q0)
+        base = left.arm.base_pose()
+        left.holding, left.cmd = True, base * Pose.from_array(grip)
+        left.last_grip = left.cmd
+        st.est = base * Pose.from_array(cube)
+        # the elbows start within a hair of each other (the joints rounded to 1e-6 rad): touching, not pressing
+        assert sum(arm_contact_forces(b, robot.body, *links).values()) < 1.0
+
+    # the straight 12 cm retreat on the elbow posture the trial's check chose: the arm's least margin
+    # never falls below where it starts (another pair of parts is inside the clearance there, -15 mm),
+    # so a check on the least margin passed it; the elbows' own pair goes from about -6 to -14 mm, and
+    # the engine finds them pressing where the arm ends
+    start()
+    back = left.arm.base_pose().inv() * st.back_off(left.cmd, 0.12)
+    q1 = np.array(chosen)
+    assert np.linalg.norm(left.arm.fk(q1[None])[0][:3, 3] - back.p) < 1e-3
+    path = q0[None] + np.linspace(0.0, 1.0, 11)[:, None] * (q1 - q0)[None]
+    pairs = st.grasp.arm_margin(st, left, path)
+    least = pairs.min(axis=1)
+    assert least[0] < -0.01 and least[1:].min() >= least[0]
+    worse = (pairs[1:] < np.minimum(0.0, pairs[0]) - 1e-9).any(axis=0)
+    assert worse.any()
+    assert not st._arm_clears(left, q0, q1)
+    left.arm.move_to_joints(q1, settle=0.3)
+    pressed = arm_contact_forces(b, robot.body, *links)
+    assert sum(pressed.values()) > 5.0, pressed
+    assert set(pressed) == {("l_elbow_flex_link", "r_elbow_flex_link")}, pressed
+
+    # the machine's retreat from the same start: the full 12 cm (in steps on other elbow postures), no
+    # contact on the way or at the end
+    start()
+    st.release_hand(left, 0.12)
+    assert not [e for e in ctx.recorder.events if e["kind"] == "arm_contact"]
+    assert arm_contact_forces(b, robot.body, *links) == {}
+    approach = left.last_grip.rotation.apply([1.0, 0.0, 0.0])
+    backed = float(np.dot(left.last_grip.p - left.arm.tcp_pose().p, approach))
+    assert backed > 0.115
