@@ -300,6 +300,23 @@ def arm_contact_forces(
     return out
 
 
+def _avoid_note(
+    hand: Hand, label: str, q: np.ndarray, nearest: np.ndarray, other: np.ndarray | None
+) -> dict:
+    """An ``arm_avoid`` event's fields: the move from ``q`` whose ``nearest`` solution was not clear of
+    the other arm, and how far the clear ``other`` one moves the joints (``found: False``: none)."""
+    return dict(
+        hand=hand.side,
+        label=label,
+        nearest_change=round(float(np.max(np.abs(nearest - q))), 2),
+        **(
+            {"joint_change": round(float(np.max(np.abs(other - q))), 2)}
+            if other is not None
+            else {"found": False}
+        ),
+    )
+
+
 def _box_gap(local: np.ndarray, half: np.ndarray | float) -> float:
     """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
     return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=1)))
@@ -648,17 +665,8 @@ class BimanualRubiksMachine:
         if self._arm_clears(hand, q, q1):
             return sol
         row = self._arm_clear_row(hand, sent, q)
-        self.ctx.recorder.event(
-            "arm_avoid",
-            hand=hand.side,
-            label=f"{label} as sent",
-            nearest_change=round(float(np.max(np.abs(q1 - q))), 2),
-            **(
-                {"joint_change": round(float(np.max(np.abs(row.q[0] - q))), 2)}
-                if row is not None
-                else {"found": False}
-            ),
-        )
+        other = None if row is None else np.asarray(row.q[0], dtype=float)
+        self.ctx.recorder.event("arm_avoid", **_avoid_note(hand, f"{label} as sent", q, q1, other))
         return sol if row is None else row
 
     def _arm_contact(self, hand: Hand, label: str) -> None:
@@ -728,16 +736,7 @@ class BimanualRubiksMachine:
         if self._arm_clears(hand, q, q1):
             return q1
         other = self._arm_clear_solution(hand, target, q)
-        note = dict(
-            hand=hand.side,
-            label=label,
-            nearest_change=round(float(np.max(np.abs(q1 - q))), 2),
-            **(
-                {"joint_change": round(float(np.max(np.abs(other - q))), 2)}
-                if other is not None
-                else {"found": False}
-            ),
-        )
+        note = _avoid_note(hand, label, q, q1, other)
         if notes is None:
             self.ctx.recorder.event("arm_avoid", **note)
         else:
