@@ -71,16 +71,18 @@ class BimanualConfig:
     #: a sideways retreat's steps, the pre-touch sweeps; and, as a preference only, a detour's straight
     #: legs; a detour whose legs and turn all keep clear is taken before any that does not, its way out
     #: along the approach or any of ``machine.WAYS_OUT``: ``transit``) must keep the arm clear of the
-    #: other arm on its joint path (margin >= 0 all the way; an arm that starts nearer, never nearer than
-    #: it starts). The nearest IK solution that does not is replaced by the clear one of least joint
+    #: other arm on its joint path (every pair of the two arms' parts at margin >= 0 all the way; a pair
+    #: that starts nearer, never nearer than it starts). The nearest IK solution that does not is replaced by the clear one of least joint
     #: change among those solved from the arm's joints with each joint moved by each of
     #: ``arm_check_offsets`` either way (the 7-DOF arm's elbow swings about the shoulder-wrist line while
     #: the hand keeps its pose); an ``arm_avoid`` event records it. With none,
     #: the move counts as one the arm cannot make smoothly (a retreat goes sideways or is cut, a sweep is
     #: skipped), except a detour's step, made as before (the event says ``found: false``: refusing it
-    #: ended SAPIEN Rubiks-1-50 ``unreachable`` where the move, elbows touching, had been harmless). Moves
-    #: to a grip's stand-off (beyond its detour), the approach and the hand-over turn are not checked this
-    #: way (a grip's posture is, by the grasp module). Why: every arm contact recorded in 14 sensor-aided
+    #: ended SAPIEN Rubiks-1-50 ``unreachable`` where the move, elbows touching, had been harmless). Every
+    #: move's joints as the arm solves them for its target with the injected errors are judged the same
+    #: way before it moves (``send``; an ``arm_avoid`` event whose label ends "as sent"), which covers the
+    #: moves not solved step by step (a stand-off beyond its detour, an approach, a hand-over take or
+    #: turn); where none is clear the solved one is made. Why: every arm contact recorded in 14 sensor-aided
     #: PR2 trials (1-50, 1-100 and 5-20, both engines, AMD VM; 20-70 N) was the giver's elbow on the
     #: taker's just after the hand-over's retreat, whose nearest solution folds the elbow inwards as the
     #: hand backs off; on the Intel VM one such contact pushed the holding arm 27 mm and ended PyBullet

@@ -24,6 +24,7 @@ grasp module, not a new state machine (docs/strategies.md, "Adding a robot").
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol
 
@@ -208,9 +209,10 @@ class GraspModule(Protocol):
 
     Optional: ``arm_margin(m, hand, q) -> np.ndarray``: how far (m) each part of ``hand``'s arm at each row
     of joints ``q`` stays beyond the robot's required clearance from each part of the other arm where it
-    is (negative: nearer), one column per pair of parts (or one column: the arm as a whole); with it the moves solved from the arm's joints (retreats, the pre-touch sweeps; a detour's straight
-    legs as a preference, and the choice of a detour's way out) keep the arms apart (``arm_check``). A
-    module without it is not checked.
+    is (negative: nearer), one column per pair of parts (or one column: the arm as a whole); with it
+    every move's joints as sent, and the moves solved from the arm's joints (retreats, the pre-touch
+    sweeps; a detour's straight legs as a preference, and the choice of a detour's way out), keep the
+    arms apart (``arm_check``). A module without it is not checked.
 
     Optional: ``roll_offset(m, hand) -> float | None``: where the gripped layer's axis lies from the
     rotator's approach axis along its finger axis (m), as the hand's own closed fingers measure it (None:
@@ -647,15 +649,15 @@ class BimanualRubiksMachine:
         ``arm_margin``; else None: :meth:`RobotArm.move_to_pose` solves as it always did).
 
         Why: the planner checks the joints it solved for the *believed* target, but the arm solves the
-        sent target again, and the 7-DOF arm's elbow can settle elsewhere along its self-motion
-        (measured, SAPIEN Rubiks-1-20 at c26a79a, 536.8 s: a retreat whose planned posture was clear
-        ended with the elbows pressing 35.5 N, the capsule model putting them 1.3 mm into each other).
-        Moves planned without a check (a hand-over take's approach) are judged here too. Where the
+        sent target again, so those are the joints that reach the other arm or not (in the one case
+        traced, SAPIEN Rubiks-1-20 at 536.1 s, they were within 9 mrad of the planned ones; that
+        contact came from the check's least-margin rule, :meth:`_arm_clears`). Moves planned without a
+        check (a hand-over take's approach, a grip's approach) are judged here too. Where the
         solved path does not keep the arm clear (:meth:`_arm_clears`) the clear solution of the same
         target with least joint change is taken instead (an ``arm_avoid`` event, its label ending
         "as sent"); where there is none, the solved one (the event says ``found: false``). A path
         that is clear is moved exactly as before: the check draws no random number."""
-        if getattr(self.grasp, "arm_margin", None) is None or not self.config.arm_check:
+        if self._arm_margin_hook() is None:
             return None
         sol = hand.arm.solve_pose(sent, seed_q=seed_q)
         if not bool(sol.success[0]):
@@ -1043,6 +1045,11 @@ class BimanualRubiksMachine:
         need = min(start - min(5e-3, 0.5 * start), self.config.sweep_clearance)
         return self.sweep_clearance(hand, q0, q1, points) >= need
 
+    def _arm_margin_hook(self) -> Callable[..., np.ndarray] | None:
+        """The grasp module's ``arm_margin`` hook where the arm check is on (``arm_check``), else None:
+        the one switch for every check of the arm against the other arm."""
+        return getattr(self.grasp, "arm_margin", None) if self.config.arm_check else None
+
     def _arm_clears(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, n: int = 11) -> bool:
         """Whether the straight joint path ``q0`` -> ``q1`` keeps ``hand``'s arm clear of the other arm where
         it is: each pair of parts' ``arm_margin`` at ``n`` points of the path never below 0 or, for a pair
@@ -1054,8 +1061,8 @@ class BimanualRubiksMachine:
         joints) must not bring another pair in. Judged on the least margin, a retreat whose forearm-elbow
         pair stayed at -15.7 mm let the two elbows go from -6.0 to -14.1 mm: 42 N in the engine
         (SAPIEN Rubiks-1-20 sensor-aided seed 0 at c26a79a, 536.1 s)."""
-        margin_of = getattr(self.grasp, "arm_margin", None)
-        if margin_of is None or not self.config.arm_check:
+        margin_of = self._arm_margin_hook()
+        if margin_of is None:
             return True
         s = np.linspace(0.0, 1.0, n)[:, None]
         margin = np.asarray(margin_of(self, hand, q0[None] + s * (q1 - q0)[None]), dtype=float)
@@ -1157,8 +1164,7 @@ class BimanualRubiksMachine:
         a ``detour`` event is recorded. With the arm check (``arm_check``, the grasp module's
         ``arm_margin``) a detour that also keeps the arm clear of the other arm, out along the approach
         or any of :data:`WAYS_OUT`, comes first (:meth:`_arm_clear_detour`). If none does, the direct
-        move is made and
-        a warning recorded, unless its path enters the believed cube or the table from a start
+        move is made and a warning recorded, unless its path enters the believed cube or the table from a start
         outside them: then the trial ends ``unreachable`` (the move would knock the cube).
 
         ``detour``: take the detour even if the direct move clears (a change of arm branch: the
@@ -1194,8 +1200,8 @@ class BimanualRubiksMachine:
             # the straight path enters the believed cube (or the table) and no detour out along the
             # approach goes round: the other ways out (``WAYS_OUT``: straight up, then towards the
             # stand-off's side of the cube, ...; measured: PyBullet Rubiks-5-10 sensor-aided seed 0
-            # trial 3, a giver that had retreated sideways in front of the cube, its wrist flex on its soft limit, had no straight
-            # way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
+            # trial 3, a giver that had retreated sideways in front of the cube, its wrist flex on its
+            # soft limit, had no straight way back along its approach; 10 cm up, the turn and the way in all clear. SAPIEN
             # Rubiks-5-100 trial 3, a hand 13 cm in front of the cube going to a stand-off on its left:
             # only the way out 10-15 cm to the left clears. Both ended `unreachable` here before)
             plan = self._first_detour(hand, target, WAYS_OUT, q0, plan_seed, points, label)
@@ -1271,8 +1277,8 @@ class BimanualRubiksMachine:
     ) -> _Detour | None:
         """The first detour whose every leg is clear of the cube *and* keeps the arm clear of the other
         arm (:meth:`_arm_clears` on each step's joint path, the turn's included): out along the approach
-        at each of ``detour_distances``, then each of :data:`WAYS_OUT` in turn. None without the grasp module's ``arm_margin``, with ``arm_check`` off, or if no
-        detour is clear of both; :meth:`transit` then takes its detour as before. Nothing moves and no
+        at each of ``detour_distances``, then each of :data:`WAYS_OUT` in turn. None without the grasp
+        module's ``arm_margin``, with ``arm_check`` off, or if no detour is clear of both; :meth:`transit` then takes its detour as before. Nothing moves and no
         event is recorded here.
 
         Why: every arm contact left in 34 sensor-aided PR2 trials with the retreats checked (AMD VM,
@@ -1281,7 +1287,7 @@ class BimanualRubiksMachine:
         cube's side; for 17 of the 19 steps flagged no elbow posture was clear, so only another way out
         helps (measured, SAPIEN Rubiks-5-20 seed 1 trial 3 at 277.7 s: out along the approach the
         margin falls to -44 mm at 25 and 35 cm; sideways towards the stand-off it stays 3.3 mm)."""
-        if getattr(self.grasp, "arm_margin", None) is None or not self.config.arm_check:
+        if self._arm_margin_hook() is None:
             return None
         ways = (None, *WAYS_OUT)
         return self._first_detour(hand, target, ways, q0, plan_seed, points, label, arm_clear=True)
