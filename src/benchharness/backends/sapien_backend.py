@@ -570,8 +570,9 @@ class SapienBackend(Backend):
         sel = b.joint_selection(joints)
         if not b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit):
             return False
+        # the values just stored, as Python floats (what target_q[sel].tolist() gives back)
         self._send_targets(
-            b, sel.tolist(), b.drive.target_q[sel].tolist(), b.drive.target_v[sel].tolist()
+            b, sel.tolist(), [float(x) for x in positions], [float(x) for x in velocities]
         )
         return True
 

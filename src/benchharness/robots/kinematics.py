@@ -345,7 +345,11 @@ class _SerialModel:
             t = t @ local[:, k]
             frames[:, k] = t
         tip = t @ self.post
-        z = np.einsum("bkij,kj->bki", frames[:, :, :3, :3], self._axes)  # (B, K, 3) world axes
+        rot = frames[:, :, :3, :3]
+        # many restarts: einsum is ~2x faster on a contiguous copy (same bits); few: the copy costs
+        if b > 8:
+            rot = np.ascontiguousarray(rot)
+        z = np.einsum("bkij,kj->bki", rot, self._axes)  # (B, K, 3) world axes
         d = tip[:, None, :3, 3] - frames[:, :, :3, 3]
         zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
         dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]

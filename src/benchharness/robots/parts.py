@@ -430,7 +430,7 @@ class Gripper:
         self._force = np.asarray(config.force_limit, dtype=float)
         self._targets = config.joint_targets(self.command)
         self.lower, self.upper = robot.joint_limits(config.joints)
-        self._link_sent: np.ndarray | None = None  # fingertip targets last sent (linkages)
+        self._link_sent: list[float] | None = None  # fingertip targets last sent (linkages)
         self._link_cb: tuple[object, int] | None = (
             None  # (backend, step-callback handle) while moving
         )
@@ -546,10 +546,11 @@ class Gripper:
             )
         leaders, names, stiffness, damping, force_limit = plan
         pos, vel = self.robot.joint_motion(leaders)
-        pl = pos.tolist()
-        t = np.array([k.target(p) for k, p in zip(links, pl)])
-        v = np.array([k.rate(p) * w for k, p, w in zip(links, pl, vel.tolist())])
-        moving = bool(np.abs(vel).max() > 1e-4)
+        # plain floats, not arrays: two or three values per call, NumPy's per-call cost dominated
+        pl, vl = pos.tolist(), vel.tolist()
+        t = [k.target(p) for k, p in zip(links, pl)]
+        v = [k.rate(p) * w for k, p, w in zip(links, pl, vl)]
+        moving = max(abs(w) for w in vl) > 1e-4
         if moving and (self._link_cb is None or self._link_cb[0] is not be):
             self._link_cb = (be, be.add_step_callback(self._aim_linkages))
         elif not moving and self._link_cb is not None:
@@ -560,7 +561,7 @@ class Gripper:
         if (
             not moving
             and self._link_sent is not None
-            and np.max(np.abs(t - self._link_sent)) < 1e-7
+            and max(abs(a - b) for a, b in zip(t, self._link_sent)) < 1e-7
         ):
             return
         self._link_sent = None if moving else t
