@@ -299,3 +299,81 @@ def test_a_retreat_is_judged_per_pair_of_arm_parts_and_keeps_the_elbows_apart(ma
     approach = left.last_grip.rotation.apply([1.0, 0.0, 0.0])
     backed = float(np.dot(left.last_grip.p - left.arm.tcp_pose().p, approach))
     assert backed > 0.115
+
+
+#: a giver's release after a hand-over, recorded at 525.575 s of SAPIEN Rubiks-5-100 dead-reckoning seed 0
+#: trial 1 (91e88f9): the right (giving) arm's joints, the left (holding) arm's, both grippers' joints, the
+#: right tool's grip, the left's, the believed cube and the true one (the right arm's base frame, x, y, z,
+#: qx, qy, qz, qw). The right hand points down at the cube's top, pads on its +-y faces; the left
+#: pinches its +-x faces from +y. The straight way up leaves the arm's branch (the shoulder lift on its
+#: soft limit); the trial slid the right hand 6 cm along +x into the left's finger (28-103 N).
+HANDOVER_RELEASE = (
+    [0.078291, -0.327517, -2.676612, -1.258537, -0.658929, -0.781773, -8.693778],
+    [-0.148509, 0.065556, 3.519427, -1.034519, -1.898754, -1.835188, 15.186838],
+    [0.027483, 0.027517],
+    [0.026645, 0.02882],
+    [0.65, -0.0, -0.27731, -0.0, -0.707107, -0.0, -0.707107],
+    [0.65, 0.013331, -0.290641, 0.707107, -0.707107, -0.0, 0.0],
+    [0.65, -0.0, -0.290641, -0.0, 0.0, -1.0, -0.0],
+    [0.652786, -0.000889, -0.295519, 0.007897, -0.003611, -0.99996, 0.001923],
+)
+
+
+@pytest.mark.parametrize("backend", ("pybullet", "sapien"))
+def test_a_sideways_retreat_into_the_other_hands_fingers_is_refused_and_the_arm_changes_posture(
+    make_ctx, backend
+):
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+    from benchharness.strategies.pr2_rubiks.strategy import DeadReckoningStrategy
+
+    ctx, b = make_ctx(backend, "R")
+    st = DeadReckoningStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
+    assert st.run_trial(ctx).failure is None
+    robot = ctx.robot
+    giver, taker = st.hands["right"], st.hands["left"]
+    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
+    q, taker_q, grip_q, taker_grip_q, grip, taker_grip, est, cube = HANDOVER_RELEASE
+
+    def start() -> Pose:
+        _place(b, robot, taker.arm, np.array(taker_q))
+        _place(b, robot, giver.arm, np.array(q))
+        base = giver.arm.base_pose()
+        b.set_joint_positions(robot.body, taker_grip_q, joints=taker.gripper.joints)
+        b.set_joint_positions(robot.body, grip_q, joints=giver.gripper.joints)
+        b.set_pose(st.cube.body, base * Pose.from_array(cube))
+        taker.gripper.close(obj=st.cube.body)
+        giver.gripper.close(obj=st.cube.body)
+        giver.holding, giver.cmd = True, base * Pose.from_array(grip)
+        giver.last_grip = giver.cmd
+        taker.holding, taker.cmd = True, base * Pose.from_array(taker_grip)
+        st.est = base * Pose.from_array(est)
+        assert arm_contact_forces(b, robot.body, *links) == {}
+        return st.cube.pose()
+
+    # the trial's slide: 6 cm along +x (the left's finger axis) in 2 cm steps; the believed boxes say
+    # the right fingertips run into the left's finger, and the engine finds them pressing
+    held = start()
+    giver.gripper.open()
+    points = st._hand_points()
+    q0 = giver.arm.positions()
+    slid = Pose(giver.cmd.p + np.array([0.06, 0.0, 0.0]), giver.cmd.q)
+    q1 = giver.arm.ik((giver.arm.base_pose().inv() * slid).as_matrix()[None], seed_q=q0).q[0]
+    assert st.hand_gap(giver, q0, q0, points) > 0.0 == st.hand_gap(giver, q0, q1, points)  # inside
+    pressed = 0.0
+    for i in (1, 2, 3):
+        giver.arm.move_to_pose(Pose(giver.cmd.p + np.array([0.02 * i, 0.0, 0.0]), giver.cmd.q))
+        pressed = max(pressed, sum(arm_contact_forces(b, robot.body, *links).values()))
+    assert pressed > 3.0  # SAPIEN 74 N (the cube knocked out of the left hand), PyBullet 4.9 N
+
+    # the machine's release from the same start: +x is refused at its first step, -x does not clear the
+    # cube, so the arm turns its forearm in place, the tool held, and backs straight up the full 12 cm
+    held = start()
+    st.release_hand(giver, 0.12)
+    kinds = [e["kind"] for e in ctx.recorder.events]
+    avoid = [e for e in ctx.recorder.events if e["kind"] == "hand_avoid"]
+    assert avoid and avoid[0]["direction"] == [1.0, 0.0, 0.0] and avoid[0]["side_cm"] == 2
+    assert "retreat_posture" in kinds and "retreat_side" not in kinds and "arm_contact" not in kinds
+    assert arm_contact_forces(b, robot.body, *links) == {}
+    approach = giver.last_grip.rotation.apply([1.0, 0.0, 0.0])
+    assert float(np.dot(giver.last_grip.p - giver.arm.tcp_pose().p, approach)) > 0.115
+    assert np.linalg.norm(st.cube.pose().p - held.p) < 0.01  # still in the left hand

@@ -111,6 +111,20 @@ class BimanualConfig:
     #: swung the forearm roll 2.1 rad); its retreat was cut to 0 cm and the re-grip's move knocked the
     #: cube (SAPIEN Rubiks-1-20 sensor-aided seed 0).
     side_retreat: float = 0.10
+    #: a sideways retreat's step must keep the hand this far (m) from the other hand's gripper where the
+    #: robot believes it (the grasp module's ``hand_boxes``: its commanded pose, closed on the cube's
+    #: width while it holds), or, for a hand that starts nearer, never more than 5 mm nearer than it
+    #: starts; a direction whose slide does not is given up (a ``hand_avoid`` event). 0: no check. Why:
+    #: the slide was checked against the cube and the other *arm* only, and a giver above the cube slid
+    #: its fingertips 6 cm along the taker's finger axis into the taker's finger (28-103 N; SAPIEN
+    #: Rubiks-5-100 dead-reckoning seed 0 trial 1, 526 s).
+    hand_clearance: float = 0.01
+    #: a retreat with no straight or sideways way out first changes the arm's posture in place, the tool
+    #: held at its pose, to the IK solution from the arm's joints with one joint moved by one of these
+    #: (rad, either way) whose straight retreat then goes the whole way
+    #: (:meth:`.machine.BimanualRubiksMachine._posture_route`, a ``retreat_posture`` event); else the
+    #: retreat is cut short, as before. (): never.
+    retreat_posture_offsets: tuple[float, ...] = (0.25, 0.5, 0.75)
     #: a free hand swings round the cube on an arc about its believed centre in Cartesian waypoints at most
     #: this many degrees apart (:meth:`.machine.BimanualRubiksMachine._swing`): one joint-space move from
     #: one side of the cube to another sweeps the hand along whatever path the joints take.

@@ -1018,17 +1018,50 @@ class BimanualRubiksMachine:
         long tier; a free hand's joint-space swing to its stand-off checked clear of the cube drove the
         wrist into the table's edge at 295 N, where the arm stuck 258 mm from its target, and the
         re-grip closed on nothing (SAPIEN Rubiks-1-50 sensor-aided seed 0, move 38)."""
-        s = np.linspace(0.0, 1.0, n)[:, None]
-        t = np.asarray(hand.arm.fk(q0 + s * (q1 - q0)), dtype=float)
-        w = hand.arm.base_pose().as_matrix() @ t
-        # the rotations copied out first: einsum runs ~3x faster on contiguous blocks, same bits
-        rot = np.ascontiguousarray(w[:, :3, :3])
-        p = (np.einsum("nij,pj->npi", rot, points) + w[:, None, :3, 3]).reshape(-1, 3)
+        p = self._path_points(hand, q0, q1, points, n)
         centre, half = self.table_box()
         return min(
             _box_gap(self.est.rotation.inv().apply(p - self.est.p), CUBE_HALF),
             _box_gap(p - centre, half),
         )
+
+    @staticmethod
+    def _path_points(
+        hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int
+    ) -> np.ndarray:
+        """The hand's ``points`` (tool frame) in the world at ``n`` configurations evenly along the straight
+        joint path ``q0`` -> ``q1`` (forward kinematics), stacked ((n x N) x 3)."""
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        t = np.asarray(hand.arm.fk(q0 + s * (q1 - q0)), dtype=float)
+        w = hand.arm.base_pose().as_matrix() @ t
+        # the rotations copied out first: einsum runs ~3x faster on contiguous blocks, same bits
+        rot = np.ascontiguousarray(w[:, :3, :3])
+        return (np.einsum("nij,pj->npi", rot, points) + w[:, None, :3, 3]).reshape(-1, 3)
+
+    def hand_gap(
+        self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int = 16
+    ) -> float:
+        """Least distance (m) of ``hand``'s ``points`` along the straight joint path ``q0`` -> ``q1`` from
+        the other hand's gripper where the robot believes it (the grasp module's ``hand_boxes``); inf
+        without that hook."""
+        boxes_of = getattr(self.grasp, "hand_boxes", None)
+        if boxes_of is None:
+            return float("inf")
+        p = self._path_points(hand, q0, q1, points, n)
+        return min(
+            _box_gap((p - c) @ rot, half) for c, rot, half in boxes_of(self, self.other(hand))
+        )
+
+    def _hands_clear(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray) -> bool:
+        """Whether the straight joint path ``q0`` -> ``q1`` keeps ``hand`` clear of the other hand's gripper
+        (:meth:`hand_gap`): never nearer than ``hand_clearance`` or, for a hand that starts nearer (a
+        giver's open pads just round the taker's fingers), than it starts less 5 mm (at most half of it),
+        as :meth:`_clears` judges the cube. True with ``hand_clearance`` 0 or without ``hand_boxes``."""
+        if self.config.hand_clearance <= 0 or getattr(self.grasp, "hand_boxes", None) is None:
+            return True
+        start = self.hand_gap(hand, q0, q0, points, n=1)
+        need = min(start - min(5e-3, 0.5 * start), self.config.hand_clearance)
+        return self.hand_gap(hand, q0, q1, points) >= need
 
     def _hand_points(self) -> np.ndarray | None:
         """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
@@ -1614,6 +1647,8 @@ class BimanualRubiksMachine:
         dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
         if points is not None and self.config.side_retreat > 0:
             route = self._side_route(hand, ref, dist, d, points)
+            if route is None:
+                route = self._posture_route(hand, ref, dist, d, points)
             if route is not None:
                 for way, q, lab in route:
                     self.send(hand, way, label=lab, settle=0.02, seed_q=q)
@@ -1735,10 +1770,21 @@ class BimanualRubiksMachine:
             side: list[tuple[Pose, np.ndarray, str]] = []
             q, done = q_start, False
             for i in range(1, math.floor(cfg.side_retreat / step + 1e-9) + 1):
+                q_from = q
                 part, q, ok = self._chain(
                     hand, q, [Pose(start.p + v * step * i, start.q)], "retreat side", points, False
                 )
                 if not ok:
+                    break
+                if not self._hands_clear(hand, q_from, q, points):
+                    self.ctx.recorder.event(
+                        "hand_avoid",
+                        hand=hand.side,
+                        label="retreat side",
+                        direction=np.round(v, 2).tolist(),
+                        side_cm=round(100 * step * i),
+                        gap_mm=round(1000 * self.hand_gap(hand, q_from, q, points), 1),
+                    )
                     break
                 side += part
                 if self.sweep_clearance(hand, q, q, points, n=1) >= cfg.sweep_clearance:
@@ -1757,6 +1803,77 @@ class BimanualRubiksMachine:
             ]
             last, _, _ = self._chain(hand, q, ways, "retreat", points, True)
             return side, last, v
+        return None
+
+    def _posture_route(
+        self, hand: Hand, ref: Pose, dist: float, d: float, points: np.ndarray
+    ) -> list[tuple[Pose, np.ndarray, str]] | None:
+        """A retreat when neither the straight way out nor a sideways one does: the arm first changes its
+        posture where the hand is (the 7-DOF arm's self-motion: the tool held at its commanded pose while
+        the elbow swings), then backs off straight along the approach from ``dist`` to ``d`` in 2 cm steps.
+
+        The postures tried are the IK solutions of the hand's pose from the arm's joints with each joint
+        moved by each of ``retreat_posture_offsets`` either way (one batched call, no random draw), least
+        joint change first; the way there is solved at the same pose from seeds evenly between (steps of
+        at most 0.05 rad), every step smooth, clear of the cube (:meth:`_clears`) and of the other arm
+        (:meth:`_arm_clears`), and the way back must go the whole way (:meth:`_chain`). Why: a giver whose
+        shoulder lift rested on its soft limit could not rise (its first 2 cm step swung the upper-arm and
+        forearm rolls 0.7 rad through the cube), its sideways slides ran into the taker's fingers both
+        ways, and its elbow swung 0.4 rad in place let it back straight out (SAPIEN Rubiks-5-100
+        dead-reckoning seed 0 trial 1, 525.6 s). Returns the waypoints (pose, IK solution, label) or None;
+        a ``retreat_posture`` event records a route found."""
+        offsets, step = self.config.retreat_posture_offsets, 0.02
+        n_back = max(0, math.floor((d - dist) / step + 1e-9))
+        if not offsets or n_back == 0:
+            return None
+        q0 = hand.arm.positions()
+        dof = len(q0)
+        seeds = np.stack(
+            [q0 + s * o * np.eye(dof)[j] for j in range(dof) for o in offsets for s in (1.0, -1.0)]
+        )
+        base = hand.arm.base_pose()
+        here = hand.cmd
+        row = (base.inv() * here).as_matrix()
+        res = hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
+        found = [
+            (float(np.max(np.abs(np.asarray(res.q[i], dtype=float) - q0))), int(i))
+            for i in np.flatnonzero(np.asarray(res.success, dtype=bool))
+        ]
+        backs = [self.back_off(ref, dist + step * (i + 1)) for i in range(n_back)]
+        for change, i in sorted(found):
+            if change < 1e-3:
+                continue  # the posture the arm is in
+            target = np.asarray(res.q[i], dtype=float)
+            n = max(1, math.ceil(change / 0.05))
+            way: list[tuple[Pose, np.ndarray, str]] = []
+            q = q0
+            for k in range(1, n + 1):
+                r = hand.arm.ik(row[None], seed_q=q0 + (target - q0) * k / n)
+                q1 = np.asarray(r.q[0], dtype=float)
+                if (
+                    not r.success[0]
+                    or float(np.max(np.abs(q1 - q))) > 0.1
+                    or not self._clears(hand, q, q1, points)
+                    or not self._arm_clears(hand, q, q1)
+                ):
+                    break
+                way.append((here, q1, "retreat posture"))
+                q = q1
+            if len(way) < n:
+                continue
+            back, _, ok = self._chain(hand, q, backs, "retreat", points, False)
+            if not ok:
+                continue
+            j = int(i) // (2 * len(offsets))
+            self.ctx.recorder.event(
+                "retreat_posture",
+                hand=hand.side,
+                joint=j,
+                offset=float(seeds[i][j] - q0[j]),
+                change_rad=round(change, 3),
+                back_cm=round(100 * (dist + step * n_back)),
+            )
+            return [*way, *back]
         return None
 
     def grip(

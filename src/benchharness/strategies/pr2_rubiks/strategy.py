@@ -147,6 +147,24 @@ class PR2Grasp:
         solves from the arm's joints from bringing a pair below 0 (``arm_check``)."""
         return arm_pair_clearance(m, hand, np.atleast_2d(q)) - self.config.arm_clearance
 
+    def hand_boxes(
+        self, m: BimanualRubiksMachine, hand: Hand
+    ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Where the robot believes ``hand``'s gripper is: its collision boxes (palm, pads and finger bars,
+        :func:`...robots.descriptions.pr2.finger_boxes`) at the commanded tool pose, the pads the cube's
+        width apart while it holds, fully open otherwise; each (centre (world), rotation (3 x 3), half
+        extents). The pre-touch self-filter drops returns from them; the machine keeps a sliding hand off
+        them (``hand_clearance``)."""
+        from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, PALM_BOX, TCP_X, finger_boxes
+
+        opening = 2 * CUBE_HALF if hand.holding else 2 * (FINGER_TRAVEL + PAD_GAP)
+        tool = hand.cmd
+        rot = tool.rotation.as_matrix()
+        return [
+            (tool.apply(np.array(c) - [TCP_X, 0.0, 0.0]), rot, np.array(size) / 2)
+            for c, size in (PALM_BOX, *finger_boxes(opening))
+        ]
+
     def take_relation(self) -> str | None:
         # in a hand-over the giver's finger lies on the face the taker comes to: only crossing fingers pass it
         return "cross"
@@ -540,32 +558,15 @@ class PR2SensorAidedGrasp(PR2Grasp):
         and is never part of a face for :func:`~benchharness.sensors.find_edges`, but still counts as
         beyond an edge when it is far behind the face (the holder's pad end 28 mm behind a side edge).
         """
-        from ...robots.descriptions.pr2 import (
-            FINGER_TRAVEL,
-            PAD_GAP,
-            PALM_BOX,
-            TCP_X,
-            finger_boxes,
-        )
         from ...sensors.raybox import ray_box
 
         if not self.config.pretouch_see_robot:
             return np.zeros(len(z), dtype=bool)
-        other = m.other(hand)
-        opening = 2 * CUBE_HALF if other.holding else 2 * (FINGER_TRAVEL + PAD_GAP)
-        boxes = [
-            (np.array(c) - [TCP_X, 0.0, 0.0], np.array(size) / 2)
-            for c, size in (PALM_BOX, *finger_boxes(opening))
-        ]
-        tool = other.cmd
-        rot = tool.rotation.as_matrix()
         out = np.zeros(len(z), dtype=bool)
         finite = np.isfinite(z)
-        for c, h in boxes:
-            hits = ray_box(o, d, tool.apply(c), rot, h + self.self_filter_margin)
-            inside = np.all(
-                np.abs((o - tool.apply(c)) @ rot) <= h + self.self_filter_margin, axis=1
-            )
+        for c, rot, h in self.hand_boxes(m, m.other(hand)):
+            hits = ray_box(o, d, c, rot, h + self.self_filter_margin)
+            inside = np.all(np.abs((o - c) @ rot) <= h + self.self_filter_margin, axis=1)
             own = finite & (inside | (hits.hit & (hits.distance <= z + self.self_filter_margin)))
             out |= own
         return out
