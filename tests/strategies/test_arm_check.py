@@ -366,7 +366,8 @@ def test_a_sideways_retreat_into_the_other_hands_fingers_is_refused_and_the_arm_
     assert pressed > 3.0  # SAPIEN 74 N (the cube knocked out of the left hand), PyBullet 4.9 N
 
     # the machine's release from the same start: +x is refused at its first step, -x does not clear the
-    # cube, so the arm turns its forearm in place, the tool held, and backs straight up the full 12 cm
+    # cube, the straight steps up do not either, so the arm turns its forearm in place, the tool held,
+    # and backs straight up the full 12 cm
     held = start()
     st.release_hand(giver, 0.12)
     kinds = [e["kind"] for e in ctx.recorder.events]

@@ -119,11 +119,11 @@ class BimanualConfig:
     #: its fingertips 6 cm along the taker's finger axis into the taker's finger (28-103 N; SAPIEN
     #: Rubiks-5-100 dead-reckoning seed 0 trial 1, 526 s).
     hand_clearance: float = 0.01
-    #: a retreat with no straight or sideways way out first changes the arm's posture in place, the tool
-    #: held at its pose, to the IK solution from the arm's joints with one joint moved by one of these
-    #: (rad, either way) whose straight retreat then goes the whole way
-    #: (:meth:`.machine.BimanualRubiksMachine._posture_route`, a ``retreat_posture`` event); else the
-    #: retreat is cut short, as before. (): never.
+    #: a retreat that neither slides sideways nor steps straight back the whole way changes the arm's
+    #: posture in place where its steps stopped, the tool held at its pose, to the IK solution from the
+    #: arm's joints with one joint moved by one of these (rad, either way) whose straight retreat then
+    #: goes the rest of the way (:meth:`.machine.BimanualRubiksMachine._posture_route`, a
+    #: ``retreat_posture`` event); else the retreat is cut short, as before. (): never.
     retreat_posture_offsets: tuple[float, ...] = (0.25, 0.5, 0.75)
     #: a free hand swings round the cube on an arc about its believed centre in Cartesian waypoints at most
     #: this many degrees apart (:meth:`.machine.BimanualRubiksMachine._swing`): one joint-space move from

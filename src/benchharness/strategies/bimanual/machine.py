@@ -1612,8 +1612,11 @@ class BimanualRubiksMachine:
         ``max_waypoint_jump`` from the arm's joints (a joint limit on the way
         out, another branch beyond), or its joint path would bring the hand
         nearer the cube (with the grasp module's ``hand_points``: see
-        :meth:`transit`), it backs off in 2 cm steps only as far as the arm
-        follows smoothly and clear, and logs a warning.
+        :meth:`transit`), it slides sideways (:meth:`_side_route`), else backs
+        off in 2 cm steps as far as the arm follows smoothly and clear; cut
+        short there, it changes the arm's posture in place and backs out
+        straight the rest of the way (:meth:`_posture_route`), else logs a
+        warning.
         """
         if hand.holding:
             self.grasp.open(self, hand)
@@ -1647,8 +1650,6 @@ class BimanualRubiksMachine:
         dist = float(np.dot(ref.p - hand.cmd.p, approach))  # already backed off
         if points is not None and self.config.side_retreat > 0:
             route = self._side_route(hand, ref, dist, d, points)
-            if route is None:
-                route = self._posture_route(hand, ref, dist, d, points)
             if route is not None:
                 for way, q, lab in route:
                     self.send(hand, way, label=lab, settle=0.02, seed_q=q)
@@ -1660,6 +1661,12 @@ class BimanualRubiksMachine:
                 break
             self.send(hand, nxt, label="retreat step", settle=0.02, seed_q=q_next)
             dist += step
+        if dist < d - 1e-6 and points is not None:  # cut short: another posture, then straight on
+            route = self._posture_route(hand, ref, dist, d, points)
+            if route is not None:
+                for way, q, lab in route:
+                    self.send(hand, way, label=lab, settle=0.02, seed_q=q)
+                return
         if dist < d - 1e-6:  # made in full in steps (one move was not smooth or clear): no warning
             self.ctx.recorder.event(
                 "warning",
@@ -1677,8 +1684,8 @@ class BimanualRubiksMachine:
         approach again as far as it goes up to ``d``. Every step is solved from the last and must be
         smooth (``max_waypoint_jump``) and clear (:meth:`_clears`). The sideways direction pointing
         away from the other hand (if it holds the cube) is tried first; one pointing towards it (more
-        than 60 degrees from square) is not tried: the check sees the cube, not the other hand's
-        fingers. Returns the waypoints (pose, IK solution, label) or None; a ``retreat_side`` event is
+        than 60 degrees from square) is not tried, and a step that brings the hand near the other
+        hand's gripper gives its direction up (:meth:`_hands_clear`, a ``hand_avoid`` event). Returns the waypoints (pose, IK solution, label) or None; a ``retreat_side`` event is
         recorded for a route found."""
         step = 0.02
         c = self.est.p
@@ -1808,7 +1815,7 @@ class BimanualRubiksMachine:
     def _posture_route(
         self, hand: Hand, ref: Pose, dist: float, d: float, points: np.ndarray
     ) -> list[tuple[Pose, np.ndarray, str]] | None:
-        """A retreat when neither the straight way out nor a sideways one does: the arm first changes its
+        """The rest of a retreat that neither a sideways slide nor straight steps made: the arm first changes its
         posture where the hand is (the 7-DOF arm's self-motion: the tool held at its commanded pose while
         the elbow swings), then backs off straight along the approach from ``dist`` to ``d`` in 2 cm steps.
 
