@@ -36,6 +36,24 @@ TARGET = [0.515054, 0.008892, -0.284503, 0.99953, -0.026336, -0.015696, 0.00017]
 LEFT_END = [-0.4954, -0.0423, 3.1542, -2.0058, -9.9117, -1.8931, -9.6108]
 
 
+def _scene(make_ctx, backend, strategy="sensor-aided"):
+    """A PR2 scene with the strategy's hands set up and no action taken: (ctx, backend, strategy, the two
+    arms' links for :func:`arm_contact_forces`)."""
+    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
+    from benchharness.strategies.pr2_rubiks.strategy import (
+        DeadReckoningStrategy,
+        SensorAidedStrategy,
+    )
+
+    cls = SensorAidedStrategy if strategy == "sensor-aided" else DeadReckoningStrategy
+    ctx, b = make_ctx(backend, "R")
+    st = cls(replace(PR2RubiksConfig().zero_error(), max_actions=0))
+    assert st.run_trial(ctx).failure is None
+    robot = ctx.robot
+    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
+    return ctx, b, st, links
+
+
 def _place(b, robot, arm, q):
     b.set_joint_positions(robot.body, q, joints=arm.joints)
     arm.move_to_joints(q, duration=0.05, settle=0.3)  # the drives hold it there
@@ -248,15 +266,9 @@ RETREAT = (
 
 @pytest.mark.parametrize("backend", ("pybullet", "sapien"))
 def test_a_retreat_is_judged_per_pair_of_arm_parts_and_keeps_the_elbows_apart(make_ctx, backend):
-    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
-    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
-
-    ctx, b = make_ctx(backend, "R")
-    st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
-    assert st.run_trial(ctx).failure is None
+    ctx, b, st, links = _scene(make_ctx, backend)
     robot = ctx.robot
     left, right = st.hands["left"], st.hands["right"]
-    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
     left_q, right_q, grip, cube, chosen = RETREAT
     q0 = np.array(left_q)
 
@@ -323,15 +335,9 @@ HANDOVER_RELEASE = (
 def test_a_sideways_retreat_into_the_other_hands_fingers_is_refused_and_the_arm_changes_posture(
     make_ctx, backend
 ):
-    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
-    from benchharness.strategies.pr2_rubiks.strategy import DeadReckoningStrategy
-
-    ctx, b = make_ctx(backend, "R")
-    st = DeadReckoningStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
-    assert st.run_trial(ctx).failure is None
+    ctx, b, st, links = _scene(make_ctx, backend, "dead-reckoning")
     robot = ctx.robot
     giver, taker = st.hands["right"], st.hands["left"]
-    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
     q, taker_q, grip_q, taker_grip_q, grip, taker_grip, est, cube = HANDOVER_RELEASE
 
     def start() -> Pose:
