@@ -324,6 +324,13 @@ def _box_gap(local: np.ndarray, half: np.ndarray | float) -> float:
     return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=1)))
 
 
+def _keeps_clear(start: float, least: float, clearance: float) -> bool:
+    """Whether a path whose least distance from something is ``least`` (m), starting ``start`` from it,
+    keeps clear: never nearer than ``clearance`` or, for a path that starts nearer, than it starts
+    less 5 mm (at most half of it). The rule of the sweep check against the cube and of the hand check."""
+    return least >= min(start - min(5e-3, 0.5 * start), clearance)
+
+
 class BimanualRubiksMachine:
     """Rubik's strategy for a two-armed robot; its grasp primitives are ``grasp``'s (see the module docstring).
 
@@ -1060,8 +1067,7 @@ class BimanualRubiksMachine:
         if self.config.hand_clearance <= 0 or getattr(self.grasp, "hand_boxes", None) is None:
             return True
         start = self.hand_gap(hand, q0, q0, points, n=1)
-        need = min(start - min(5e-3, 0.5 * start), self.config.hand_clearance)
-        return self.hand_gap(hand, q0, q1, points) >= need
+        return _keeps_clear(start, self.hand_gap(hand, q0, q1, points), self.config.hand_clearance)
 
     def _hand_points(self) -> np.ndarray | None:
         """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
@@ -1077,8 +1083,9 @@ class BimanualRubiksMachine:
         joint-space step of a few centimetres strays a few millimetres from its straight Cartesian line
         (measured: 2-3 mm for 2 cm steps of a PR2 giver's retreat); a sweep through the cube reaches 0."""
         start = self.sweep_clearance(hand, q0, q0, points, n=1)
-        need = min(start - min(5e-3, 0.5 * start), self.config.sweep_clearance)
-        return self.sweep_clearance(hand, q0, q1, points) >= need
+        return _keeps_clear(
+            start, self.sweep_clearance(hand, q0, q1, points), self.config.sweep_clearance
+        )
 
     def _arm_margin_hook(self) -> Callable[..., np.ndarray] | None:
         """The grasp module's ``arm_margin`` hook where the arm check is on (``arm_check``), else None:
@@ -1112,11 +1119,14 @@ class BimanualRubiksMachine:
         row = self._arm_clear_row(hand, target, q)
         return None if row is None else np.asarray(row.q[0], dtype=float)
 
-    def _arm_clear_row(self, hand: Hand, target: Pose, q: np.ndarray) -> IKResult | None:
-        """:meth:`_arm_clear_solution` as a one-row IK result (with its IK errors), or None."""
-        offsets = self.config.arm_check_offsets
-        if not offsets:
-            return None
+    @staticmethod
+    def _solve_from_offsets(
+        hand: Hand, target: Pose, q: np.ndarray, offsets: tuple[float, ...]
+    ) -> tuple[np.ndarray, IKResult]:
+        """IK solutions of ``target`` (world) from ``q`` with each joint moved by each of ``offsets``
+        either way, in that order (joint, offset, +/-), in one batched call with no random draw (a
+        trial's plan draws are untouched): the seeds and the result, a row per seed. The other
+        postures of the 7-DOF arm for one hand pose (the elbow swings about the shoulder-wrist line)."""
         seeds = np.stack(
             [
                 q + s * d * np.eye(len(q))[j]
@@ -1125,9 +1135,15 @@ class BimanualRubiksMachine:
                 for s in (1.0, -1.0)
             ]
         )
-        base = hand.arm.base_pose()
-        row = (base.inv() * target).as_matrix()
-        res = hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
+        row = (hand.arm.base_pose().inv() * target).as_matrix()
+        return seeds, hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
+
+    def _arm_clear_row(self, hand: Hand, target: Pose, q: np.ndarray) -> IKResult | None:
+        """:meth:`_arm_clear_solution` as a one-row IK result (with its IK errors), or None."""
+        offsets = self.config.arm_check_offsets
+        if not offsets:
+            return None
+        _, res = self._solve_from_offsets(hand, target, q, offsets)
         best: tuple[float, int] | None = None
         for i in np.flatnonzero(np.asarray(res.success, dtype=bool)):
             q1 = np.asarray(res.q[i], dtype=float)
@@ -1824,24 +1840,19 @@ class BimanualRubiksMachine:
         joint change first; the way there is solved at the same pose from seeds evenly between (steps of
         at most 0.05 rad), every step smooth, clear of the cube (:meth:`_clears`) and of the other arm
         (:meth:`_arm_clears`), and the way back must go the whole way (:meth:`_chain`). Why: a giver whose
-        shoulder lift rested on its soft limit could not rise (its first 2 cm step swung the upper-arm and
-        forearm rolls 0.7 rad through the cube), its sideways slides ran into the taker's fingers both
-        ways, and its elbow swung 0.4 rad in place let it back straight out (SAPIEN Rubiks-5-100
-        dead-reckoning seed 0 trial 1, 525.6 s). Returns the waypoints (pose, IK solution, label) or None;
+        shoulder lift was 27 mrad from its soft limit could not rise (1.8 cm up, the next step swung the
+        upper-arm and forearm rolls 0.7 rad through the cube), its slide one way ran into the taker's
+        finger and the other way left the branch as well, and its forearm roll turned 0.18 rad in place
+        let it back straight out (SAPIEN Rubiks-5-100 dead-reckoning seed 0 trial 1, 525.6 s). Returns the waypoints (pose, IK solution, label) or None;
         a ``retreat_posture`` event records a route found."""
         offsets, step = self.config.retreat_posture_offsets, 0.02
         n_back = max(0, math.floor((d - dist) / step + 1e-9))
         if not offsets or n_back == 0:
             return None
         q0 = hand.arm.positions()
-        dof = len(q0)
-        seeds = np.stack(
-            [q0 + s * o * np.eye(dof)[j] for j in range(dof) for o in offsets for s in (1.0, -1.0)]
-        )
-        base = hand.arm.base_pose()
         here = hand.cmd
-        row = (base.inv() * here).as_matrix()
-        res = hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
+        row = (hand.arm.base_pose().inv() * here).as_matrix()
+        seeds, res = self._solve_from_offsets(hand, here, q0, offsets)
         found = [
             (float(np.max(np.abs(np.asarray(res.q[i], dtype=float) - q0))), int(i))
             for i in np.flatnonzero(np.asarray(res.success, dtype=bool))
