@@ -57,6 +57,8 @@ _NUMPY_FK_MAX_BATCH = 32  #: above this, pytorch-kinematics' batched FK is as fa
 #: IK passes with at most this many rows (targets x restarts) run in NumPy (:meth:`KinematicChain._dls`),
 #: larger ones through pytorch-kinematics' batched solver
 _NUMPY_IK_MAX_ROWS = 256
+_NEXT = np.array([1, 2, 0])  #: index i+1 (mod 3) of each vector component i
+_AFTER = np.array([2, 0, 1])  #: index i+2 (mod 3)
 
 
 def __getattr__(name: str) -> Any:
@@ -215,6 +217,11 @@ def _quat_wxyz(r: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
+def _row_norm(a: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(a, axis=1)`` for a real (B, n) array: the same reduction, without its dispatch."""
+    return np.sqrt(np.add.reduce(a * a, axis=1))
+
+
 def _rotvec_between(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     """Rotation vectors (B, 3), base frame, of ``target @ current.T``: the shortest rotation current -> target.
 
@@ -223,10 +230,9 @@ def _rotvec_between(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     the axis comes from the quaternion instead.
     """
     r = target @ current.transpose(0, 2, 1)
-    v = 0.5 * np.stack(
-        [r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1
-    )
-    n = np.sqrt(np.sum(v * v, axis=1))
+    # (r21 - r12, r02 - r20, r10 - r01): component i = r[i+2, i+1] - r[i+1, i+2]
+    v = 0.5 * (r[:, _AFTER, _NEXT] - r[:, _NEXT, _AFTER])
+    n = np.sqrt(np.add.reduce(v * v, axis=1))
     angle = np.arctan2(n, 0.5 * (r[:, 0, 0] + r[:, 1, 1] + r[:, 2, 2] - 1.0))
     out = v * (angle / np.maximum(n, 1e-300))[:, None]  # n = 0 only at angle 0 (angle pi: below)
     flip = angle > np.pi - 1e-3
@@ -287,6 +293,7 @@ class _SerialModel:
         self._any_prismatic = bool(self._pris_mask.any())
         self._joint_idx = np.array(self.joint, dtype=np.intp)
         self._identity_order = self.joint == list(range(len(self.joint)))
+        self._jt: dict[int, np.ndarray] = {}  #: per batch size, the joint-transform buffer
 
     @classmethod
     def from_urdf(cls, spec) -> _SerialModel:
@@ -333,10 +340,15 @@ class _SerialModel:
         x = q if self._identity_order else q[:, self._joint_idx]  # (B, K)
         s = np.sin(x)[:, :, None, None]
         c = 1.0 - np.cos(x)[:, :, None, None]
-        jt = np.zeros((b, len(self.joint), 4, 4))
+        jt = self._jt.get(b)
+        if jt is None:  # rows 0-2 are rewritten on every call, row 3 stays (0, 0, 0, 1)
+            jt = np.zeros((b, len(self.joint), 4, 4))
+            jt[:, :, 3, 3] = 1.0
+            if b <= _NUMPY_FK_MAX_BATCH:
+                self._jt[b] = jt
         jt[:, :, :3, :3] = self._eye3 + s * self._skew + c * self._skew2
-        jt[:, :, :3, 3] = (x * self._pris)[:, :, None] * self._axes
-        jt[:, :, 3, 3] = 1.0
+        if self._any_prismatic:  # otherwise the translations stay the buffer's zeros
+            jt[:, :, :3, 3] = (x * self._pris)[:, :, None] * self._axes
         local = self._pre @ jt  # (B, K, 4, 4)
         frames = np.empty_like(local)
         t = local[:, 0]
@@ -351,11 +363,9 @@ class _SerialModel:
             rot = np.ascontiguousarray(rot)
         z = np.einsum("bkij,kj->bki", rot, self._axes)  # (B, K, 3) world axes
         d = tip[:, None, :3, 3] - frames[:, :, :3, 3]
-        zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
-        dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
-        jv = np.stack(
-            [zy * dz - zz * dy, zz * dx - zx * dz, zx * dy - zy * dx], axis=2
-        )  # z x d (np.cross: ~80 us)
+        # z x d, component i = z[i+1] d[i+2] - z[i+2] d[i+1]: the same products and differences as
+        # written out per component, in 5 array operations instead of 16 (np.cross: ~80 us)
+        jv = z[..., _NEXT] * d[..., _AFTER] - z[..., _AFTER] * d[..., _NEXT]
         if self._any_prismatic:
             jv = np.where(self._pris_mask, z, jv)
         jw = z if not self._any_prismatic else np.where(self._pris_mask, 0.0, z)
@@ -605,7 +615,7 @@ class KinematicChain:
             return dx, jac
 
         def step(qq: np.ndarray, dx: np.ndarray, jac: np.ndarray) -> np.ndarray:
-            mu = config.lm_damping * np.sum(dx * dx, axis=1)
+            mu = config.lm_damping * np.add.reduce(dx * dx, axis=1)
             a = jac @ jac.transpose(0, 2, 1) + (1e-9 + mu)[:, None, None] * eye6
             dq = (jac.transpose(0, 2, 1) @ np.linalg.solve(a, dx[:, :, None]))[:, :, 0]
             return np.clip(qq + config.lr * dq, lo, hi)
@@ -618,9 +628,7 @@ class KinematicChain:
                 break
             qa = q[idx]
             dx, jac = error(qa, idx)
-            conv = (np.linalg.norm(dx[:, :3], axis=1) < pos_tol) & (
-                np.linalg.norm(dx[:, 3:], axis=1) < rot_tol
-            )
+            conv = (_row_norm(dx[:, :3]) < pos_tol) & (_row_norm(dx[:, 3:]) < rot_tol)
             sol[idx] = qa  # converged rows keep this; the others are overwritten while they run
             active[idx[conv]] = False
             if stop_when_any and conv.any():
@@ -637,7 +645,7 @@ class KinematicChain:
             dx, jac = error(q, rows)
             q = step(q, dx, jac)
         dx, _ = error(q, rows)
-        ep, er = np.linalg.norm(dx[:, :3], axis=1), np.linalg.norm(dx[:, 3:], axis=1)
+        ep, er = _row_norm(dx[:, :3]), _row_norm(dx[:, 3:])
         conv = (ep < pos_tol) & (er < rot_tol)
         return q.reshape(b, r, dof), ep.reshape(b, r), er.reshape(b, r), conv.reshape(b, r)
 
