@@ -63,15 +63,9 @@ def _place(b, robot, arm, q):
 def test_a_retreat_that_folds_the_elbow_onto_the_other_arm_is_solved_on_another_elbow_posture(
     make_ctx, backend
 ):
-    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
-    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
-
-    ctx, b = make_ctx(backend, "R")
-    st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
-    assert st.run_trial(ctx).failure is None  # the scene and the hands, no action
+    ctx, b, st, links = _scene(make_ctx, backend)
     robot = ctx.robot
     left, right = st.hands["left"], st.hands["right"]
-    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
     q0 = np.array(LEFT_Q)
     _place(b, robot, right.arm, np.array(RIGHT_Q))
     _place(b, robot, left.arm, q0)
@@ -143,16 +137,10 @@ LABEL = "hand-over re-grip stand-off"
 def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way(
     make_ctx, backend, way
 ):
-    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
-    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
-
-    ctx, b = make_ctx(backend, "R")
-    st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
-    assert st.run_trial(ctx).failure is None
+    ctx, b, st, links = _scene(make_ctx, backend)
     robot = ctx.robot
     side, free_q, hold_q, cmd, standoff, cube, plan_q = DETOURS[way]
     free, hold = st.hands[side], st.other(st.hands[side])
-    links = tuple(robot.links_below(robot.arm(f"{s}_arm").joints[0]) for s in ("left", "right"))
     base = free.arm.base_pose()
     q0, seed = np.array(free_q), np.array(plan_q)
     target = base * Pose.from_array(standoff)
@@ -220,12 +208,8 @@ SLIDE = (
 @pytest.mark.parametrize("backend", ("pybullet", "sapien"))
 def test_an_open_hand_round_the_cube_with_no_way_up_slides_out_along_its_pads(make_ctx, backend):
     from benchharness.strategies.bimanual.machine import WAYS_OUT
-    from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
-    from benchharness.strategies.pr2_rubiks.strategy import SensorAidedStrategy
 
-    ctx, b = make_ctx(backend, "R")
-    st = SensorAidedStrategy(replace(PR2RubiksConfig().zero_error(), max_actions=0))
-    assert st.run_trial(ctx).failure is None
+    ctx, b, st, _ = _scene(make_ctx, backend)
     side, free_q, hold_q, cmd, standoff, cube, plan_q = SLIDE
     free, hold = st.hands[side], st.other(st.hands[side])
     _place(b, ctx.robot, hold.arm, np.array(hold_q))
