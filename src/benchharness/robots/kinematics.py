@@ -232,7 +232,7 @@ def _rotvec_between(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     r = target @ current.transpose(0, 2, 1)
     # (r21 - r12, r02 - r20, r10 - r01): component i = r[i+2, i+1] - r[i+1, i+2]
     v = 0.5 * (r[:, _AFTER, _NEXT] - r[:, _NEXT, _AFTER])
-    n = np.sqrt(np.add.reduce(v * v, axis=1))
+    n = _row_norm(v)
     angle = np.arctan2(n, 0.5 * (r[:, 0, 0] + r[:, 1, 1] + r[:, 2, 2] - 1.0))
     out = v * (angle / np.maximum(n, 1e-300))[:, None]  # n = 0 only at angle 0 (angle pi: below)
     flip = angle > np.pi - 1e-3
@@ -337,19 +337,7 @@ class _SerialModel:
         4x4 product per joint in the loop.
         """
         b = q.shape[0]
-        x = q if self._identity_order else q[:, self._joint_idx]  # (B, K)
-        s = np.sin(x)[:, :, None, None]
-        c = 1.0 - np.cos(x)[:, :, None, None]
-        jt = self._jt.get(b)
-        if jt is None:  # rows 0-2 are rewritten on every call, row 3 stays (0, 0, 0, 1)
-            jt = np.zeros((b, len(self.joint), 4, 4))
-            jt[:, :, 3, 3] = 1.0
-            if b <= _NUMPY_FK_MAX_BATCH:
-                self._jt[b] = jt
-        jt[:, :, :3, :3] = self._eye3 + s * self._skew + c * self._skew2
-        if self._any_prismatic:  # otherwise the translations stay the buffer's zeros
-            jt[:, :, :3, 3] = (x * self._pris)[:, :, None] * self._axes
-        local = self._pre @ jt  # (B, K, 4, 4)
+        local = self._local(q)  # (B, K, 4, 4)
         frames = np.empty_like(local)
         t = local[:, 0]
         frames[:, 0] = t
@@ -376,16 +364,26 @@ class _SerialModel:
         jac[:, 3:, self._joint_idx] = jw.transpose(0, 2, 1)
         return tip, jac
 
-    def joint_origins(self, q: np.ndarray) -> np.ndarray:
-        """Origins of the movable joints' frames in the root frame, (B, K, 3), in chain order."""
-        x = q if self._identity_order else q[:, self._joint_idx]
+    def _local(self, q: np.ndarray) -> np.ndarray:
+        """Every movable joint's transform from the previous one, ``pre_k @ joint_k(q)``, (B, K, 4, 4)."""
+        b = q.shape[0]
+        x = q if self._identity_order else q[:, self._joint_idx]  # (B, K)
         s = np.sin(x)[:, :, None, None]
         c = 1.0 - np.cos(x)[:, :, None, None]
-        jt = np.zeros((q.shape[0], len(self.joint), 4, 4))
+        jt = self._jt.get(b)
+        if jt is None:  # rows 0-2 are rewritten on every call, row 3 stays (0, 0, 0, 1)
+            jt = np.zeros((b, len(self.joint), 4, 4))
+            jt[:, :, 3, 3] = 1.0
+            if b <= _NUMPY_FK_MAX_BATCH:
+                self._jt[b] = jt
         jt[:, :, :3, :3] = self._eye3 + s * self._skew + c * self._skew2
-        jt[:, :, :3, 3] = (x * self._pris)[:, :, None] * self._axes
-        jt[:, :, 3, 3] = 1.0
-        local = self._pre @ jt
+        if self._any_prismatic:  # otherwise the translations stay the buffer's zeros
+            jt[:, :, :3, 3] = (x * self._pris)[:, :, None] * self._axes
+        return self._pre @ jt
+
+    def joint_origins(self, q: np.ndarray) -> np.ndarray:
+        """Origins of the movable joints' frames in the root frame, (B, K, 3), in chain order."""
+        local = self._local(q)
         out = np.empty((q.shape[0], len(self.joint), 3))
         t = local[:, 0]
         out[:, 0] = t[:, :3, 3]

@@ -1121,12 +1121,13 @@ class BimanualRubiksMachine:
 
     @staticmethod
     def _solve_from_offsets(
-        hand: Hand, target: Pose, q: np.ndarray, offsets: tuple[float, ...]
+        hand: Hand, row: np.ndarray, q: np.ndarray, offsets: tuple[float, ...]
     ) -> tuple[np.ndarray, IKResult]:
-        """IK solutions of ``target`` (world) from ``q`` with each joint moved by each of ``offsets``
-        either way, in that order (joint, offset, +/-), in one batched call with no random draw (a
-        trial's plan draws are untouched): the seeds and the result, a row per seed. The other
-        postures of the 7-DOF arm for one hand pose (the elbow swings about the shoulder-wrist line)."""
+        """IK solutions of ``row`` (the tool's 4x4 target in the arm's base frame) from ``q`` with each
+        joint moved by each of ``offsets`` either way, in that order (joint, offset, +/-), in one
+        batched call with no random draw (a trial's plan draws are untouched): the seeds and the
+        result, a row per seed. The other postures of the 7-DOF arm for one hand pose (the elbow
+        swings about the shoulder-wrist line)."""
         seeds = np.stack(
             [
                 q + s * d * np.eye(len(q))[j]
@@ -1135,7 +1136,6 @@ class BimanualRubiksMachine:
                 for s in (1.0, -1.0)
             ]
         )
-        row = (hand.arm.base_pose().inv() * target).as_matrix()
         return seeds, hand.arm.ik(np.repeat(row[None], len(seeds), axis=0), seed_q=seeds)
 
     def _arm_clear_row(self, hand: Hand, target: Pose, q: np.ndarray) -> IKResult | None:
@@ -1143,7 +1143,8 @@ class BimanualRubiksMachine:
         offsets = self.config.arm_check_offsets
         if not offsets:
             return None
-        _, res = self._solve_from_offsets(hand, target, q, offsets)
+        row = (hand.arm.base_pose().inv() * target).as_matrix()
+        _, res = self._solve_from_offsets(hand, row, q, offsets)
         best: tuple[float, int] | None = None
         for i in np.flatnonzero(np.asarray(res.success, dtype=bool)):
             q1 = np.asarray(res.q[i], dtype=float)
@@ -1852,7 +1853,7 @@ class BimanualRubiksMachine:
         q0 = hand.arm.positions()
         here = hand.cmd
         row = (hand.arm.base_pose().inv() * here).as_matrix()
-        seeds, res = self._solve_from_offsets(hand, here, q0, offsets)
+        seeds, res = self._solve_from_offsets(hand, row, q0, offsets)
         found = [
             (float(np.max(np.abs(np.asarray(res.q[i], dtype=float) - q0))), int(i))
             for i in np.flatnonzero(np.asarray(res.success, dtype=bool))
