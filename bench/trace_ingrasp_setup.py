@@ -37,6 +37,11 @@ def main() -> None:
         help="print each fingertip's slip on the object since release (mm, object frame), the "
         "fingertip distances (mm) and the largest joint tracking error of the used fingers (rad)",
     )
+    ap.add_argument(
+        "--others",
+        action="store_true",
+        help="name the other links touching the object (link@separation mm and their force)",
+    )
     ap.add_argument("--since-s", type=float, default=0.0, help="start tracing at this sim time")
     ap.add_argument(
         "--exec-config", default="", help="ExecConfig overrides, k=v,k=v (floats, none, friction)"
@@ -95,6 +100,7 @@ def main() -> None:
             nrm: dict[str, np.ndarray] = {}
             pen: dict[str, float] = {}
             other = 0.0
+            others: dict[str, float] = {}
             for ct in be.contacts(st["obj"], None):
                 if ct.body_b == rob.body and ct.link_b and ct.link_b.endswith("_tip"):
                     f[ct.link_b] = f.get(ct.link_b, 0.0) + ct.normal_force
@@ -105,11 +111,18 @@ def main() -> None:
                     pen[ct.link_b] = min(pen.get(ct.link_b, 0.0), float(ct.distance))
                 else:
                     other += ct.normal_force
+                    name = f"{ct.link_b or 'ground'}@{1e3 * float(ct.distance):+.1f}mm"
+                    others[name] = others.get(name, 0.0) + ct.normal_force
             tips = " ".join(f"{k[5:]}={f.get(k, 0.0):5.2f}" for k in TIPS)
             d = (c - st["c0"]) * 1e3
             rows.append(
                 f"t={t:6.3f} {st['phase']:8s} dCoM_palm[mm]=({d[0]:6.1f},{d[1]:6.1f},{d[2]:6.1f}) "
                 f"|v|={np.linalg.norm(v):5.3f} N: {tips} other={other:5.2f}"
+                + (
+                    " (" + ", ".join(f"{k} {x:.2f}" for k, x in sorted(others.items())) + ")"
+                    if args.others and others
+                    else ""
+                )
             )
             if args.slip or args.normals:  # fingertip centres in the world, for either report
                 tips_w = {k: be.get_link_pose(rob.body, k).as_matrix()[:3, 3] for k in TIPS}

@@ -85,6 +85,14 @@ def _triangles(s: Shape) -> tuple[np.ndarray, np.ndarray]:
 #: a base speed above this (m/s or rad/s) counts as a blow-up, as does a non-finite state
 MAX_SPEED = 1.0e4
 _RAY_BATCH = 16000
+#: children ``createCollisionShapeArray`` keeps (PyBullet's MAX_COMPOUND_COLLISION_SHAPES); the rest
+#: are dropped silently, so a body with more is built another way or refused
+_MAX_COMPOUND_SHAPES = 16
+#: collision margin (m) of convex mesh bodies. Bullet's default, 1 mm, puts every contact 1 mm outside
+#: the object's model (an in-hand fingertip then presses ~0.65 N harder than its squeeze asks); at 0
+#: contacts are exact but Bullet's ray casts miss thin hulls; at 0.1 mm contacts sit 0.1 mm out and
+#: rays hit (bench/bench_object_surfaces.py, docs/backends.md "Object surfaces")
+_MESH_MARGIN = 1.0e-4
 _ATTACH_MAX_FORCE = 1.0e5
 #: rad or m: the drive law's cached inverse mass matrix is recomputed once a joint moved this far
 MASS_MATRIX_REFRESH = 1.0e-3
@@ -487,6 +495,13 @@ class PyBulletBackend(Backend):
         arrays = self._shape_arrays(shapes, tmp)  # mesh hulls are written to disk once, here
         if len(shapes) == 1:
             col = pb.createCollisionShape(**self._shape_args(shapes[0], tmp), physicsClientId=cid)
+        elif all(isinstance(s, MeshShape) for s in shapes):  # convex pieces of a scanned object
+            col = self._mesh_compound(shapes, tmp)  # type: ignore[arg-type]
+        elif len(shapes) > _MAX_COMPOUND_SHAPES:
+            raise BackendError(
+                f"{len(shapes)} collision shapes in one body: PyBullet keeps at most "
+                f"{_MAX_COMPOUND_SHAPES} of a mixed compound (convex meshes alone have no limit)"
+            )
         else:  # one single-link multibody; several shapes become one compound collision shape
             col = self._compound(arrays)
         texture = -1
@@ -519,6 +534,10 @@ class PyBulletBackend(Backend):
         }
         if not fixed:
             kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
+        if any(isinstance(s, MeshShape) for s in shapes):
+            # Bullet grows a convex hull by its collision margin, 1 mm by default: the object was 1 mm
+            # fatter than its model (bench/bench_object_surfaces.py)
+            kw["collisionMargin"] = _MESH_MARGIN
         pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
         if vis >= 0 and texture >= 0:
             pb.changeVisualShape(
@@ -574,6 +593,33 @@ class PyBulletBackend(Backend):
             poss.append(s.pose.p.tolist())
             orns.append(s.pose.q.tolist())
         return types, half, radii, lengths, files, poss, orns
+
+    def _mesh_compound(self, shapes: Sequence[MeshShape], tmp: list[str]) -> int:
+        """Convex pieces as one compound, all of them: one OBJ file with an object per piece.
+
+        ``createCollisionShapeArray`` keeps only the first ``_MAX_COMPOUND_SHAPES`` (16) children and
+        drops the rest without a word (measured: a 32-piece YCB scan kept 16, and rays passed through
+        the missing half). A GEOM_MESH file with several objects becomes a compound with one convex
+        hull child per object, with no such limit. Each piece's pose is baked into its vertices.
+        """
+        import trimesh
+
+        fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_pieces_")
+        os.close(fd)
+        tmp.append(fn)
+        offset = 1
+        with open(fn, "w") as out:
+            for i, s in enumerate(shapes):
+                hull = trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+                v = s.pose.apply(np.asarray(hull.vertices, dtype=float))
+                out.write(f"o piece{i}\n")
+                out.writelines(f"v {x!r} {y!r} {z!r}\n" for x, y, z in v.tolist())
+                out.writelines(
+                    f"f {a + offset} {b + offset} {c + offset}\n"
+                    for a, b, c in np.asarray(hull.faces).tolist()
+                )
+                offset += len(v)
+        return pb.createCollisionShape(pb.GEOM_MESH, fileName=fn, physicsClientId=self._cid)
 
     def _compound(self, arrays: tuple[list, ...]) -> int:
         cid = self._cid
