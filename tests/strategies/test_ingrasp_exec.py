@@ -226,7 +226,12 @@ def test_runner_refuses_unknown_task(planner):
 @pytest.mark.slow
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])
 def test_through_the_runner(backend, tmp_path):
-    """A full trial through the runner (5 s hold, scoring, 10 % rule), relaxed-rigidity as published."""
+    """A full trial through the runner (5 s hold, scoring, 10 % rule), relaxed-rigidity as published.
+
+    banana-01, held on both engines: orange-01 (``TASK``), used here before, drops in SAPIEN's hold
+    since both engines' object surfaces match the scan (eef4cbe; docs/ingrasp.md, "What still
+    separates the engines": PhysX's fingertip contact has no torsional friction).
+    """
     from benchharness.runner.spec import RunSpec
     from benchharness.runner.trial import execute_trial, plan_for
 
@@ -236,7 +241,7 @@ def test_through_the_runner(backend, tmp_path):
         strategy="relaxed-rigidity",
         backend=backend,
     )
-    index = next(i for i, it in plan_for(spec).items.items() if it.task_id == TASK)
+    index = next(i for i, it in plan_for(spec).items.items() if it.task_id == "banana-01")
     rec = execute_trial(spec, index)
     assert rec.status.value in ("success", "discarded"), rec.message
     assert rec.outcome["metrics"]["err_pos"] < 1.5
