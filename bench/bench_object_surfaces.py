@@ -24,9 +24,10 @@ import argparse
 import numpy as np
 import trimesh
 
-from benchharness.backends.interface import PhysicsConfig, Sphere
+from benchharness.backends.interface import PhysicsConfig
 from benchharness.geometry import Pose
 from benchharness.objects import load_object
+from benchharness.objects.surface_check import contact_separations, overlapping_spheres
 from benchharness.plugin import get_manager
 
 OBJECTS = (
@@ -69,23 +70,6 @@ def rays(ref: trimesh.Trimesh, n: int, rng: np.random.Generator):
     return origins, u, hit, 2 * span
 
 
-def spheres(model, ref: trimesh.Trimesh, n: int, overlap: float, rng: np.random.Generator):
-    """Sphere centres overlapping the model's surface by ``overlap`` m, and their exact separations.
-
-    Points are sampled on the pieces' faces and kept where a sphere there overlaps the union of the
-    pieces by ``overlap`` to within 0.1 mm (a point on a face inside another piece is not on the
-    surface); the exact separation is the least over the convex pieces (each engine reports one
-    contact per piece).
-    """
-    pts, fi = trimesh.sample.sample_surface(ref, 4 * n, seed=int(rng.integers(2**31)))
-    centres = pts + ref.face_normals[fi] * (TIP_RADIUS - overlap)
-    pieces = [trimesh.Trimesh(s.vertices, s.faces).convex_hull for s in model.collision]
-    exact = np.min([-trimesh.proximity.signed_distance(p, centres) for p in pieces], axis=0)
-    exact = exact - TIP_RADIUS
-    keep = np.flatnonzero(np.abs(exact + overlap) < 1e-4)[:n]
-    return centres[keep], exact[keep]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--objects", default=",".join(OBJECTS))
@@ -106,7 +90,9 @@ def main() -> None:
         ref = reference(model)
         rng = np.random.default_rng(args.seed)
         origins, u, ref_hit, max_d = rays(ref, args.rays, rng)
-        centres, exact = spheres(model, ref, args.spheres, args.overlap * 1e-3, rng)
+        centres, exact = overlapping_spheres(
+            model, args.spheres, TIP_RADIUS, args.overlap * 1e-3, seed=args.seed
+        )
         for engine in args.engines.split(","):
             # no gravity, the object free: a fixed-fixed pair makes no contacts in either engine
             be = m.create("backend", engine, config=PhysicsConfig(gravity=(0.0, 0.0, 0.0)))
@@ -116,16 +102,7 @@ def main() -> None:
                 h = be.ray_cast(origins, u, max_d)
                 off = (ref_hit - np.where(h.hit, h.distance, np.nan)) * 1e3
                 off = off[np.isfinite(off)]
-                sep = np.full(len(centres), np.inf)
-                tips = [
-                    be.add_body([Sphere(TIP_RADIUS)], Pose(c), 0.0, fixed=True) for c in centres
-                ]
-                be.step(1)
-                index = {t: i for i, t in enumerate(tips)}
-                for ct in be.contacts(obj, None):
-                    i = index.get(ct.body_b)
-                    if i is not None:
-                        sep[i] = min(sep[i], float(ct.distance))
+                sep = contact_separations(be, obj, centres, TIP_RADIUS)
                 err = (sep - exact) * 1e3
                 fin = np.isfinite(err)
                 missed = int(np.sum(~fin) + np.sum(sep[fin] > 0))

@@ -99,8 +99,7 @@ def main() -> None:
             f: dict[str, float] = {}
             nrm: dict[str, np.ndarray] = {}
             pen: dict[str, float] = {}
-            other = 0.0
-            others: dict[str, float] = {}
+            others: dict[str, float] = {}  # every other link (or the ground) touching the object
             for ct in be.contacts(st["obj"], None):
                 if ct.body_b == rob.body and ct.link_b and ct.link_b.endswith("_tip"):
                     f[ct.link_b] = f.get(ct.link_b, 0.0) + ct.normal_force
@@ -110,10 +109,10 @@ def main() -> None:
                     )
                     pen[ct.link_b] = min(pen.get(ct.link_b, 0.0), float(ct.distance))
                 else:
-                    other += ct.normal_force
                     name = f"{ct.link_b or 'ground'}@{1e3 * float(ct.distance):+.1f}mm"
                     others[name] = others.get(name, 0.0) + ct.normal_force
             tips = " ".join(f"{k[5:]}={f.get(k, 0.0):5.2f}" for k in TIPS)
+            other = sum(others.values())
             d = (c - st["c0"]) * 1e3
             rows.append(
                 f"t={t:6.3f} {st['phase']:8s} dCoM_palm[mm]=({d[0]:6.1f},{d[1]:6.1f},{d[2]:6.1f}) "

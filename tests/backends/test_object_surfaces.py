@@ -16,8 +16,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchharness.backends.interface import BackendError, Box, MeshShape, PhysicsConfig, Sphere
+from benchharness.backends.interface import BackendError, Box, MeshShape, PhysicsConfig
 from benchharness.geometry import Pose
+from benchharness.objects.surface_check import contact_separations, overlapping_spheres
 from benchharness.plugin import get_manager
 
 pytestmark = pytest.mark.sim
@@ -28,17 +29,6 @@ OVERLAP = 0.001
 #: worst contact separation error allowed (m): PyBullet keeps a 0.1 mm margin (its ray casts miss thin
 #: hulls without one); PhysX cooks to ~0.05 mm
 TOLERANCE = {"pybullet": 0.00015, "sapien": 0.0002}
-
-
-def _overlapping_spheres(model, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Centres of spheres overlapping the model's surface by OVERLAP, and their exact separations."""
-    pieces = [trimesh.Trimesh(s.vertices, s.faces).convex_hull for s in model.collision]
-    union = trimesh.util.concatenate(pieces)
-    pts, fi = trimesh.sample.sample_surface(union, 6 * n, seed=seed)
-    centres = pts + union.face_normals[fi] * (TIP - OVERLAP)
-    exact = np.min([-trimesh.proximity.signed_distance(p, centres) for p in pieces], axis=0) - TIP
-    keep = np.flatnonzero(np.abs(exact + OVERLAP) < 1e-4)[:n]  # on the union's outer surface
-    return centres[keep], exact[keep]
 
 
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])
@@ -54,20 +44,12 @@ def test_fingertip_contacts_meet_the_model_surface(backend, name):
     from benchharness.objects import load_object
 
     model = load_object(name)
-    centres, exact = _overlapping_spheres(model, 40)
+    centres, exact = overlapping_spheres(model, 40, TIP, OVERLAP)
     assert len(centres) >= 30
     be = get_manager().create("backend", backend, config=PhysicsConfig(gravity=(0.0, 0.0, 0.0)))
     try:
         obj = be.add_body(pose=Pose(), **model.body_kwargs())  # free: fixed pairs make no contacts
-        tips = {
-            be.add_body([Sphere(TIP)], Pose(c), 0.0, fixed=True): i for i, c in enumerate(centres)
-        }
-        be.step(1)
-        sep = np.full(len(centres), np.inf)
-        for ct in be.contacts(obj, None):
-            i = tips.get(ct.body_b)
-            if i is not None:
-                sep[i] = min(sep[i], float(ct.distance))
+        sep = contact_separations(be, obj, centres, TIP)
     finally:
         be.close()
     assert np.all(np.isfinite(sep)), (

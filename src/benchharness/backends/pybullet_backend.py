@@ -24,6 +24,7 @@ import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pybullet as pb
@@ -94,6 +95,15 @@ _MAX_COMPOUND_SHAPES = 16
 #: rays hit (bench/bench_object_surfaces.py, docs/backends.md "Object surfaces")
 _MESH_MARGIN = 1.0e-4
 _ATTACH_MAX_FORCE = 1.0e5
+
+
+def _convex_hull(s: MeshShape) -> Any:
+    """The convex hull of a mesh shape's vertices (a ``trimesh.Trimesh``): what Bullet collides with."""
+    import trimesh
+
+    return trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+
+
 #: rad or m: the drive law's cached inverse mass matrix is recomputed once a joint moved this far
 MASS_MATRIX_REFRESH = 1.0e-3
 
@@ -492,11 +502,12 @@ class PyBulletBackend(Backend):
         coloured = self.draws_visuals and (bool(visuals) or any(s.rgba is not None for s in shapes))
         mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         tmp: list[str] = []
-        arrays = self._shape_arrays(shapes, tmp)  # mesh hulls are written to disk once, here
+        hulls = {i: _convex_hull(s) for i, s in enumerate(shapes) if isinstance(s, MeshShape)}
+        arrays = self._shape_arrays(shapes, tmp, hulls)  # mesh hulls are written to disk once, here
         if len(shapes) == 1:
             col = pb.createCollisionShape(**self._shape_args(shapes[0], tmp), physicsClientId=cid)
         elif all(isinstance(s, MeshShape) for s in shapes):  # convex pieces of a scanned object
-            col = self._mesh_compound(shapes, tmp)  # type: ignore[arg-type]
+            col = self._mesh_compound(shapes, hulls, tmp)
         elif len(shapes) > _MAX_COMPOUND_SHAPES:
             raise BackendError(
                 f"{len(shapes)} collision shapes in one body: PyBullet keeps at most "
@@ -555,8 +566,12 @@ class PyBulletBackend(Backend):
             )
         )
 
-    def _shape_arrays(self, shapes: list[Shape], tmp: list[str]) -> tuple[list, ...]:
+    def _shape_arrays(
+        self, shapes: list[Shape], tmp: list[str], hulls: dict[int, Any]
+    ) -> tuple[list, ...]:
         """Per-shape fields for PyBullet's ``create*ShapeArray`` calls (collision and visual alike).
+
+        ``hulls``: the convex hull of each mesh shape, by index.
 
         Returns ``(types, half_extents, radii, lengths, file_names, positions, orientations)``.
         """
@@ -568,9 +583,9 @@ class PyBulletBackend(Backend):
         poss: list[list[float]] = []
         orns: list[list[float]] = []
         fields: tuple[int, list[float], float, float, str]
-        for s in shapes:
+        for i, s in enumerate(shapes):
             if isinstance(s, MeshShape):
-                fields = (pb.GEOM_MESH, [0, 0, 0], 0.0, 0.0, self._hull_obj(s, tmp))
+                fields = (pb.GEOM_MESH, [0, 0, 0], 0.0, 0.0, self._hull_obj(hulls[i], tmp))
             elif isinstance(s, Box):
                 fields = (pb.GEOM_BOX, list(map(float, s.half_extents)), 0.0, 0.0, "")
             elif isinstance(s, Sphere):
@@ -594,23 +609,22 @@ class PyBulletBackend(Backend):
             orns.append(s.pose.q.tolist())
         return types, half, radii, lengths, files, poss, orns
 
-    def _mesh_compound(self, shapes: Sequence[MeshShape], tmp: list[str]) -> int:
+    def _mesh_compound(self, shapes: Sequence[Shape], hulls: dict[int, Any], tmp: list[str]) -> int:
         """Convex pieces as one compound, all of them: one OBJ file with an object per piece.
 
         ``createCollisionShapeArray`` keeps only the first ``_MAX_COMPOUND_SHAPES`` (16) children and
         drops the rest without a word (measured: a 32-piece YCB scan kept 16, and rays passed through
         the missing half). A GEOM_MESH file with several objects becomes a compound with one convex
         hull child per object, with no such limit. Each piece's pose is baked into its vertices.
+        ``hulls``: each piece's convex hull, by index.
         """
-        import trimesh
-
         fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_pieces_")
         os.close(fd)
         tmp.append(fn)
         offset = 1
         with open(fn, "w") as out:
             for i, s in enumerate(shapes):
-                hull = trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+                hull = hulls[i]
                 v = s.pose.apply(np.asarray(hull.vertices, dtype=float))
                 out.write(f"o piece{i}\n")
                 out.writelines(f"v {x!r} {y!r} {z!r}\n" for x, y, z in v.tolist())
@@ -704,10 +718,7 @@ class PyBulletBackend(Backend):
         return tex
 
     @staticmethod
-    def _hull_obj(s: MeshShape, tmp: list[str]) -> str:
-        import trimesh
-
-        hull = trimesh.convex.convex_hull(np.asarray(s.vertices, dtype=float))
+    def _hull_obj(hull: Any, tmp: list[str]) -> str:
         fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_hull_")
         os.close(fd)
         hull.export(fn)
