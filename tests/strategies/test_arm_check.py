@@ -158,7 +158,9 @@ def test_a_detour_out_along_the_approach_into_the_other_arm_goes_out_another_way
     # the detour the trial took: out along the approach to 25 cm. Clear of the cube, not of the other
     # arm: the model's margin goes below zero and the engine finds the elbows pressing
     start()
-    old = st._plan_detour(free, target, None, 0.25, q0, seed, st._hand_points(), LABEL, notes=[])
+    old = st._plan_detour(
+        free, target, None, 0.25, q0, seed, st._hand_points(free), LABEL, notes=[]
+    )
     assert old is not None
     outs = [q0, *(q for _, q in old.leg_out)]
     ins = [old.qb, *(q for _, q in old.leg_in)]
@@ -218,7 +220,7 @@ def test_an_open_hand_round_the_cube_with_no_way_up_slides_out_along_its_pads(ma
     free.cmd = base * Pose.from_array(cmd)
     st.est = base * Pose.from_array(cube)
     target = base * Pose.from_array(standoff)
-    q0, seed, points = free.arm.positions(), np.array(plan_q), st._hand_points()
+    q0, seed, points = free.arm.positions(), np.array(plan_q), st._hand_points(free)
 
     # the hand points down at the cube's top, 38 mm above its centre, pads on its +-y faces: straight up
     # (its approach) takes another arm branch, every world-frame way out drags a pad through the cube
@@ -344,7 +346,7 @@ def test_a_sideways_retreat_into_the_other_hands_fingers_is_refused_and_the_arm_
     # the right fingertips run into the left's finger, and the engine finds them pressing
     held = start()
     giver.gripper.open()
-    points = st._hand_points()
+    points = st._hand_points(giver)
     q0 = giver.arm.positions()
     slid = Pose(giver.cmd.p + np.array([0.06, 0.0, 0.0]), giver.cmd.q)
     q1 = giver.arm.ik((giver.arm.base_pose().inv() * slid).as_matrix()[None], seed_q=q0).q[0]

@@ -265,7 +265,7 @@ def test_handover_turn_brings_a_tilted_believed_cube_back_to_faces_level():
     for i, t in enumerate(arm.targets, start=1):
         assert np.array_equal(t, path.at(grip, i, n).as_matrix())
     arm.targets.clear()
-    m._hand_points = lambda: None
+    m._hand_points = lambda hand: None
     m.plan_rng = np.random.default_rng(0)
     m.turn_postures(hand, Pose(np.zeros(3)), [grip], "x", -math.pi / 2, n_seeds=1)
     for i in range(n + 1):

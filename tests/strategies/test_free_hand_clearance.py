@@ -62,7 +62,7 @@ def _touches_table(b, robot, table, q: np.ndarray) -> set[str]:
 
 def test_stand_off_move_through_the_table_is_not_clear(scene):
     machine, hand, b, robot, table = scene
-    points = machine._hand_points()
+    points = machine._hand_points(hand)
     assert points is not None
     s = np.linspace(0.0, 1.0, 16)
     wrist = np.array([_wrist_to_table(machine, hand, Q_START + t * (Q_GOAL - Q_START)) for t in s])

@@ -109,6 +109,8 @@ BH_DIST_MASS = 0.04
 #: axis): proximal 58 x 16 x 24 mm centred 37 mm out; distal 47 x 14 x 22 mm from 3 mm to the tip.
 PROX_BOX = ((0.058, 0.016, 0.024), (0.037, 0.0, 0.0))
 DIST_BOX = ((BH_TIP_LEN - 0.003, 0.014, 0.022), ((BH_TIP_LEN + 0.003) / 2, 0.0, 0.0))
+#: the palm's collision cylinder in the palm link frame: (radius, length), centre (m)
+PALM_CYLINDER = ((0.045, 0.07), (0.0, 0.0, 0.035))
 
 
 def _wam(m: UrdfBuilder, side: str) -> None:
@@ -222,7 +224,7 @@ def _hand(m: UrdfBuilder, s: str) -> None:
     src = f"{BARRETT_MODEL} models/hand.urdf.xacro"
     m.link(
         f"{p}_palm_link",
-        [Geom("cylinder", (0.045, 0.07), (0.0, 0.0, 0.035))],
+        [Geom("cylinder", *PALM_CYLINDER)],
         BH_PALM_MASS,
         source="BH8-280 palm (frame = barrett_model bhand_palm_link = herb_description hand_base): "
         "1.18 kg hand (datasheet), palm share assumed; cylinder r 45 mm, 70 mm tall",

@@ -30,6 +30,7 @@ __all__ = [
     "grip_pose",
     "rotate_about_point",
     "turned_about_approach",
+    "unit_box_grid",
 ]
 
 DIRECTIONS: dict[str, np.ndarray] = {
@@ -115,3 +116,11 @@ def rotate_about_point(
 def turned_about_approach(tcp: Pose, angle: float) -> Pose:
     """The tool frame after a wrist roll of ``angle`` rad (about its own x, through its origin)."""
     return Pose.from_rotation(tcp.p, tcp.rotation * Rotation.from_rotvec([angle, 0.0, 0.0]))
+
+
+def unit_box_grid(n: int = 5) -> np.ndarray:
+    """``n`` x ``n`` x ``n`` points evenly filling the unit box [-0.5, 0.5]^3, corners included ((n^3) x 3):
+    scaled by a box's size and moved to its centre they fill a hand's collision box for the sweep checks
+    (the grasp modules' ``hand_points``)."""
+    g = np.linspace(-0.5, 0.5, n)
+    return np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)

@@ -203,9 +203,11 @@ class GraspModule(Protocol):
     grips and across which its fingers close; the wrist's last joint rolls
     about the approach axis.
 
-    Optional: ``hand_points() -> np.ndarray`` (N x 3, tool frame, m), points filling the open
-    hand; with it the machine keeps a free hand's moves to its stand-offs from sweeping through
-    the cube (:meth:`BimanualRubiksMachine.transit`). A module without it is not checked.
+    Optional: ``hand_points(m, hand) -> np.ndarray`` (N x 3, tool frame, m), points filling ``hand``
+    with its fingers open (as they are when it moves free: a fixed shape, or the hand's pre-shape
+    from its own joint readings); with it the machine keeps a free hand's moves to its stand-offs
+    and its retreats from sweeping through the cube (:meth:`BimanualRubiksMachine.transit`,
+    :meth:`BimanualRubiksMachine.release_hand`). A module without it is not checked.
 
     Optional: ``arm_margin(m, hand, q) -> np.ndarray``: how far (m) each part of ``hand``'s arm at each row
     of joints ``q`` stays beyond the robot's required clearance from each part of the other arm where it
@@ -827,7 +829,7 @@ class BimanualRubiksMachine:
         """
         cfg = self.config
         n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
-        points = self._hand_points() if with_retreat else None
+        points = self._hand_points(hand) if with_retreat else None
         # (waypoint of the turn, of n; retreat distance) of each step
         steps = [(i, 0.0) for i in range(1, n + 1)]
         if with_retreat and points is None:
@@ -885,7 +887,7 @@ class BimanualRubiksMachine:
         """
         cfg = self.config
         n = max(1, cfg.handover_waypoints) * max(1, round(abs(angle) / (math.pi / 2)))
-        points = self._hand_points()
+        points = self._hand_points(hand)
         m = max(1, math.ceil(cfg.handover_retreat / 0.02 - 1e-9))
         # a continuous joint over the turn centred on where it is (IK keeps it on the seed's branch:
         # drawn over [-pi, pi], a wrist roll wound to 12 rad by the twists was unwound 9.7 rad)
@@ -963,7 +965,7 @@ class BimanualRubiksMachine:
             self.send(hand, far, label=label, settle=0.05, seed_q=seed_q)
             return
         base = hand.arm.base_pose()
-        points = self._hand_points()
+        points = self._hand_points(hand)
         for way in self._arc(c, [u0, u1], [hand.cmd.q, far.q], r0, r1):
             q_now = hand.arm.positions()
             res = hand.arm.ik((base.inv() * way).as_matrix()[None], seed_q=q_now)
@@ -1069,12 +1071,13 @@ class BimanualRubiksMachine:
         start = self.hand_gap(hand, q0, q0, points, n=1)
         return _keeps_clear(start, self.hand_gap(hand, q0, q1, points), self.config.hand_clearance)
 
-    def _hand_points(self) -> np.ndarray | None:
-        """The grasp module's open-hand points (tool frame), or None (no sweep checks)."""
+    def _hand_points(self, hand: Hand) -> np.ndarray | None:
+        """The grasp module's points of ``hand`` with its fingers open (tool frame), or None (no sweep
+        checks)."""
         points_of = getattr(self.grasp, "hand_points", None)
         if points_of is None or self.config.sweep_clearance <= 0:
             return None
-        return np.asarray(points_of(), dtype=float)
+        return np.asarray(points_of(self, hand), dtype=float)
 
     def _clears(self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray) -> bool:
         """Whether the straight joint path ``q0`` -> ``q1`` keeps the hand clear of the believed cube:
@@ -1227,7 +1230,7 @@ class BimanualRubiksMachine:
         ``settle``: how long the arm settles at ``target`` (s).
         """
         cfg = self.config
-        points = self._hand_points()
+        points = self._hand_points(hand)
         if points is None:
             self.send(hand, target, label=label, settle=settle, seed_q=seed_q)
             return
@@ -1646,7 +1649,7 @@ class BimanualRubiksMachine:
             or not Pose(hand.cmd.p, back.q).allclose(Pose(hand.cmd.p, hand.cmd.q), 1, 1e-3)
         ):
             return
-        points = self._hand_points()
+        points = self._hand_points(hand)
 
         def way_out(target: Pose) -> tuple[bool, np.ndarray | None]:
             """Smooth and clear of the other arm (:meth:`smooth_q`), within reach with the injected errors'

@@ -158,6 +158,14 @@ class HerbPushGraspConfig(BimanualConfig):
     giver_backward_seeds: int = 8
     #: retreat along the approach after letting go (m).
     retreat_distance: float = 0.08
+    #: a retreat whose straight way out fails does not slide sideways (the machine's ``side_retreat``) nor
+    #: change the arm's posture in place (``retreat_posture_offsets``), the PR2's ways out: it backs off in
+    #: 2 cm steps as far as they go, as before HERB's hand was checked against the cube (``hand_points``).
+    #: Measured with those ways on: PyBullet Rubiks-1-20 seed 1 took a sideways retreat at its second
+    #: hand-over, whose waypoint the arm then missed by 5.7 mm with the injected errors (past ``ik_slack``;
+    #: HERB's retreats keep no reach margin), and the trial ended `unreachable` at 76 s.
+    side_retreat: float = 0.0
+    retreat_posture_offsets: tuple[float, ...] = ()
     #: the picker and a hand-over's taker grip two slabs deep whichever hand rotates next (the machine's rule,
     #: the PR2's too): a one-slab lone grip lost the cube on PyBullet (Rubiks-1-10: the pick's close turned it
     #: 9 deg and the second grasp's push met no face; Rubiks-5-5: a one-slab hold turned it 16 deg as the other

@@ -20,14 +20,17 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
-from ...robots.descriptions.herb import DIST_BOX, PROX_BOX
-from ..bimanual.frames import DIRECTIONS, grip_candidates, rotate_about_point
+from ...robots.descriptions.herb import DIST_BOX, PALM_CYLINDER, PROX_BOX
+from ..bimanual.frames import DIRECTIONS, grip_candidates, rotate_about_point, unit_box_grid
 
 __all__ = [
     "CUBE_HALF",
     "DIRECTIONS",
     "HERB_FROM_PR2",
     "PROX_CORNERS",
+    "PROX_FILL",
+    "DIST_FILL",
+    "PALM_FILL",
     "DIST_CORNERS",
     "approach_axis",
     "band_clear",
@@ -63,6 +66,29 @@ def _box_corners(box) -> np.ndarray:
 _DIST_CORNERS = _box_corners(DIST_BOX)
 DIST_CORNERS = _DIST_CORNERS
 PROX_CORNERS = _box_corners(PROX_BOX)
+
+
+def _box_fill(box) -> np.ndarray:
+    size, centre = box
+    return np.asarray(centre) + unit_box_grid() * np.asarray(size)
+
+
+def _cylinder_fill(cylinder, n_angle: int = 12) -> np.ndarray:
+    (radius, length), centre = cylinder
+    pts = [
+        (r * np.cos(a), r * np.sin(a), z)
+        for z in np.linspace(-length / 2, length / 2, 5)
+        for r in (0.0, radius / 2, radius)
+        for a in np.linspace(0.0, 2 * np.pi, n_angle if r > 0 else 1, endpoint=False)
+    ]
+    return np.asarray(pts) + np.asarray(centre)
+
+
+#: points filling the BarrettHand's collision shapes in their link frames (5 x 5 x 5 a finger box; the
+#: palm cylinder on 5 levels of 3 rings): what the hand's sweep checks move along a joint path
+PROX_FILL = _box_fill(PROX_BOX)
+DIST_FILL = _box_fill(DIST_BOX)
+PALM_FILL = _cylinder_fill(PALM_CYLINDER)
 
 
 def approach_axis(tool: Pose) -> np.ndarray:

@@ -38,7 +38,10 @@ from .frames import (
     CUBE_HALF,
     DIRECTIONS,
     DIST_CORNERS,
+    DIST_FILL,
+    PALM_FILL,
     PROX_CORNERS,
+    PROX_FILL,
     approach_axis,
     band_clear,
     finger_extent,
@@ -566,6 +569,33 @@ class PushGrasp:
             joint_change=round(float(np.max(np.abs(q_far - q))), 2),
         )
         m.send(hand, hand.cmd, label=f"{label} give branch", settle=0.1, seed_q=q_far)
+
+    def hand_points(self, m: BimanualRubiksMachine, hand: Hand) -> np.ndarray:
+        """Points (tool frame, m) filling ``hand``'s palm and the proximal and distal boxes of its three
+        fingers where its own joint readings put them now; the machine keeps them clear of the cube
+        along a free hand's moves (``sweep_clearance``: stand-offs, swings, retreats).
+
+        Read from the joints, not fixed as the PR2's open gripper is: a free BarrettHand moves in the
+        pre-shape of its next grip (spread 90 deg, outer fingers open, the thumb flexed ahead of the
+        palm to where the face will be), and the flexed thumb is what reaches the cube. Why: without
+        these points HERB's moves were not checked at all; a re-gripping hand's 3.4 rad joint-space
+        move to its give-grip stand-off swept its thumb into the cube held by the other hand (93 N),
+        turned it 70 deg in that hand and the cube fell in the hand-over (PyBullet Rubiks-1-20 seed 1,
+        t = 261.9 s; docs/herb_push_grasp.md).
+        """
+        prefix = hand.arm.config.tcp_link.split("_")[0] + "_bh_"
+        tool = hand.arm.tcp_pose()
+        inv = tool.rotation.inv()
+        parts = [(f"{prefix}palm_link", PALM_FILL)] + [
+            (f"{prefix}finger_{f}{n}_link", PROX_FILL if n == 2 else DIST_FILL)
+            for f in (1, 2, 3)
+            for n in (2, 3)
+        ]
+        out = []
+        for name, fill in parts:
+            link = m.b.get_link_pose(m.robot.body, name)
+            out.append(inv.apply(link.rotation.apply(fill) + link.p - tool.p))
+        return np.concatenate(out)
 
     def _pinch_sides(
         self, m: BimanualRubiksMachine, hand: Hand

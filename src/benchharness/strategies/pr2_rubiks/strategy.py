@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ...geometry import Pose
-from ..bimanual.frames import DIRECTIONS, along, grip_candidates
+from ..bimanual.frames import DIRECTIONS, along, grip_candidates, unit_box_grid
 from ..bimanual.machine import (
     CUBE_HALF,
     BimanualRubiksMachine,
@@ -89,8 +89,7 @@ def _open_hand_points() -> np.ndarray:
     from ...robots.descriptions.pr2 import GRIPPER_MAX_OPENING, PALM_BOX, TCP_X, finger_boxes
 
     boxes = [*finger_boxes(GRIPPER_MAX_OPENING), PALM_BOX]
-    g = np.linspace(-0.5, 0.5, 5)
-    grid = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    grid = unit_box_grid()
     pts = np.concatenate([np.asarray(c) + grid * np.asarray(s) for c, s in boxes])
     # the wrist flex link's sphere (the palm frame's origin): a stand-off move that changes the arm's
     # posture can swing the wrist through the cube with the hand itself well clear (measured: 52 N from
@@ -133,7 +132,7 @@ class PR2Grasp:
     def hand_state(self) -> Any:
         return None
 
-    def hand_points(self) -> np.ndarray:
+    def hand_points(self, m: BimanualRubiksMachine, hand: Hand) -> np.ndarray:
         """Points (tool frame, m) filling the open hand's collision boxes: both pads and finger bars at
         the 90 mm opening, the palm (:func:`...robots.descriptions.pr2.finger_boxes`) and the wrist flex
         link's sphere behind it (rigid with the tool frame: on the wrist roll axis); the machine keeps
