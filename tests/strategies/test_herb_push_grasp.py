@@ -515,3 +515,71 @@ def test_a_turn_with_no_smooth_grip_on_a_tilted_belief_is_levelled(tmp_path):
     assert len(moves) >= 5 and all(m["as_intended"] for m in moves), moves
     assert cause != "unreachable"
     assert any(e["kind"] == "stopped" for e in events)
+
+
+def test_hand_points_fill_the_pre_shaped_hand_where_an_independent_fk_puts_it(
+    make_backend, make_robot
+):
+    """HERB's ``hand_points`` (the machine's sweep checks keep them off the cube): read from the engine's
+    link poses at the hand's joints, each part's points must lie in that part's collision shape where
+    yourdfpy's FK of the same URDF and joint readings puts it relative to the tool frame, and the
+    flexed thumb must be among them (the part that struck the held cube, docs/herb_push_grasp.md)."""
+    from types import SimpleNamespace
+
+    import yourdfpy
+
+    from benchharness.robots.descriptions.herb import DIST_BOX, PALM_CYLINDER, PROX_BOX
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.frames import (
+        DIST_FILL,
+        PALM_FILL,
+        PROX_FILL,
+        thumb_face_depth,
+    )
+    from benchharness.strategies.herb_rubiks.push import preshape
+    from benchharness.strategies.herb_rubiks.strategy import PushGrasp
+
+    be = make_backend("pybullet")
+    robot = make_robot("herb")
+    robot.spawn(be)
+    arm, hand = robot.arm("right_arm"), robot.hand("right_hand")
+    cfg = HerbPushGraspConfig()
+    preshape(hand, cfg.spread, cfg.rotator_thumb_flex, outer_flex=cfg.outer_open_flex)
+    points = PushGrasp(cfg).hand_points(
+        SimpleNamespace(b=be, robot=robot), SimpleNamespace(arm=arm)
+    )
+
+    urdf = yourdfpy.URDF.load(
+        str(robot.urdf_path), load_meshes=False, build_collision_scene_graph=False
+    )
+    q = robot.joint_positions()
+    urdf.update_cfg(dict(zip(robot.joint_names, q)))
+    tool = urdf.get_transform("r_bh_tcp", urdf.base_link)
+    parts = [("r_bh_palm_link", PALM_FILL)] + [
+        (f"r_bh_finger_{f}{n}_link", PROX_FILL if n == 2 else DIST_FILL)
+        for f in (1, 2, 3)
+        for n in (2, 3)
+    ]
+    assert len(points) == sum(len(fill) for _, fill in parts)
+    start = 0
+    for name, fill in parts:
+        own = points[start : start + len(fill)]
+        start += len(fill)
+        link = np.linalg.inv(urdf.get_transform(name, urdf.base_link)) @ tool
+        local = own @ link[:3, :3].T + link[:3, 3]  # the part's points in its own link frame (FK)
+        if name.endswith("palm_link"):
+            (radius, length), centre = PALM_CYLINDER
+            d = local - np.asarray(centre)
+            assert np.all(np.hypot(d[:, 0], d[:, 1]) <= radius + 1e-3), name
+            assert np.all(np.abs(d[:, 2]) <= length / 2 + 1e-3), name
+        else:
+            size, centre = PROX_BOX if name.endswith("2_link") else DIST_BOX
+            assert np.all(np.abs(local - np.asarray(centre)) <= np.asarray(size) / 2 + 1e-3), name
+    # the pre-shaped thumb's distal box reaches as far along the approach (tool z) as the push expects the
+    # face (its ``face_depth``, from the same link's engine pose), past the tool frame; the open outer
+    # fingers reach farther still (62.8 mm against the thumb's 35.9 mm here)
+    thumb_distal = points[-len(DIST_FILL) :]
+    reach = float(np.max(thumb_distal[:, 2]))
+    distal = be.get_link_pose(robot.body, "r_bh_finger_33_link")
+    assert reach > 0.0
+    assert reach == pytest.approx(thumb_face_depth(arm.tcp_pose(), distal), abs=1e-6)
