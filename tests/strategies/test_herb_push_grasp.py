@@ -583,3 +583,49 @@ def test_hand_points_fill_the_pre_shaped_hand_where_an_independent_fk_puts_it(
     distal = be.get_link_pose(robot.body, "r_bh_finger_33_link")
     assert reach > 0.0
     assert reach == pytest.approx(thumb_face_depth(arm.tcp_pose(), distal), abs=1e-6)
+
+
+#: PyBullet Rubiks-1-20 seed 1 before HERB's hand was checked (fb9ed1c), t = 259.06 s: the right arm's
+#: measured joints as it left for its give grip's stand-off, the joints it ended at, its hand's pre-shape
+#: (r_bh_j11, j21, j12, j13, j22, j23, j32, j33) and the belief (centre, quaternion xyzw). On the way its
+#: thumb struck the cube the left hand held (93 N) and turned it 70 deg (docs/herb_push_grasp.md).
+SWEEP_Q_START = np.array([1.5619, -0.7167, 0.7291, 1.9214, -0.9674, 0.8254, -0.2463])
+SWEEP_Q_END = np.array([-1.1453, 0.4666, -2.0407, 1.8251, -4.3345, -1.6, 0.0234])
+SWEEP_FINGERS = np.array([1.5701, 1.5698, 1.0475, 0.3365, 1.0476, 0.3365, 1.7506, 0.562])
+SWEEP_BELIEF = Pose([0.9, -0.0015, 1.1002], [0.53941, 0.45476, -0.52702, -0.47381])
+
+
+def test_the_stand_off_move_that_struck_the_held_cube_is_not_clear(make_backend, make_robot):
+    """The machine's sweep check with HERB's hand points refuses that move (its joint path), and the
+    engine, independently, finds a right-hand link inside a cube placed at the belief along the same path
+    while neither end touches it."""
+    from benchharness.strategies.bimanual.machine import Hand
+    from benchharness.strategies.herb_rubiks.config import HerbPushGraspConfig
+    from benchharness.strategies.herb_rubiks.strategy import PushGraspStrategy
+
+    be = make_backend("pybullet")
+    robot = make_robot("herb")
+    robot.spawn(be)
+    arm, gripper = robot.arm("right_arm"), robot.hand("right_hand")
+    be.set_joint_positions(robot.body, SWEEP_FINGERS, joints=list(gripper.joints))
+    be.set_joint_positions(robot.body, SWEEP_Q_START, joints=list(arm.joints))
+    cube = be.add_body([Box((CUBE_HALF,) * 3)], SWEEP_BELIEF, 0.094, fixed=True, name="cube")
+    machine = PushGraspStrategy(HerbPushGraspConfig())
+    machine.b, machine.robot, machine.est = be, robot, SWEEP_BELIEF
+    hand = Hand("right", arm, gripper, Pose(np.zeros(3)), arm.tcp_pose())
+
+    points = machine._hand_points(hand)
+    assert points is not None
+    assert machine.sweep_clearance(hand, SWEEP_Q_START, SWEEP_Q_START, points, n=1) > 0.02
+    assert not machine._clears(hand, SWEEP_Q_START, SWEEP_Q_END, points)
+
+    def touching(q: np.ndarray) -> set[str]:
+        be.set_joint_positions(robot.body, q, joints=list(arm.joints))
+        be.set_joint_positions(robot.body, SWEEP_FINGERS, joints=list(gripper.joints))
+        be.step(1)
+        return {c.link_a for c in be.contacts(robot.body, cube) if c.link_a}
+
+    path = [SWEEP_Q_START + t * (SWEEP_Q_END - SWEEP_Q_START) for t in np.linspace(0.0, 1.0, 33)]
+    hits = [touching(q) for q in path]
+    assert not hits[0] and not hits[-1]
+    assert any(h & {"r_bh_finger_32_link", "r_bh_finger_33_link"} for h in hits), hits
