@@ -27,27 +27,17 @@ import argparse
 import json
 import math
 import sqlite3
-import xml.etree.ElementTree as ET
 from collections import defaultdict
 
 import numpy as np
 
 from benchharness.objects import load_object
-from benchharness.strategies.ingrasp.hand import TIP_LINKS, HandKinematics, _default_urdf
+from benchharness.robots.descriptions.allegro import TIP_R
+from benchharness.strategies.ingrasp.hand import HandKinematics
 from benchharness.strategies.ingrasp.tasks import published_tasks
 
 ROUND = ("apple", "orange")
 BINS = (30.0, 38.0, 42.0)  #: edges of the grip-angle bins (deg)
-
-
-def tip_radius() -> float:
-    """The fingertip sphere's radius in our Allegro description (m)."""
-    root = ET.parse(_default_urdf()).getroot()
-    link = root.find(f"link[@name='{TIP_LINKS['index']}']")
-    assert link is not None
-    sphere = link.find("collision/geometry/sphere")
-    assert sphere is not None
-    return float(sphere.attrib["radius"])
 
 
 def circumradius(p: np.ndarray) -> float:
@@ -67,10 +57,10 @@ def ball_radius(name: str) -> float:
 
 
 def published_grasps() -> None:
-    r_tip = tip_radius()
+    r_tip = TIP_R
     kin = HandKinematics()
     balls = {name: ball_radius(name) for name in ROUND}
-    print(f"fingertip sphere radius {1000 * r_tip:.1f} mm (robots/allegro/allegro.urdf)")
+    print(f"fingertip sphere radius {1000 * r_tip:.1f} mm (our Allegro description)")
     print(
         "initial grasp (task)           fingers            tip-centre distances (mm)   circle rho (mm)"
         "   ball R (mm)   predicted tilt acos(rho/(R+r))"
