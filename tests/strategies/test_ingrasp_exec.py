@@ -205,6 +205,45 @@ def test_config_validation():
         ExecConfig(palm="sideways")
     with pytest.raises(ValueError, match="squeeze_force"):
         ExecConfig(squeeze_force=-1.0)
+    with pytest.raises(ValueError, match="max_placement_penetration"):
+        ExecConfig(max_placement_penetration=0.0)
+
+
+@pytest.mark.parametrize("backend", ["pybullet", "sapien"])
+def test_a_grasp_that_does_not_fit_the_object_is_refused_before_any_physics(backend):
+    """airplane_toy-01: at the best placement the hand is 6.5 mm inside our airplane model.
+
+    The reference is the placement's own measure (``tests/test_objects_ycb.py`` holds it strictly:
+    6.51 mm, a strict xfail of "a valid grasp of the scan"). Simulated anyway, SAPIEN ejected the
+    airplane at 7-14 m/s (``simulator_error``) and PyBullet scored trials that began from the
+    interpenetration; the trial now ends ``unreachable`` with that depth, before the engine steps.
+    """
+    from benchharness.runner.contract import InhandItem, TimeBudget, TrialContext
+    from benchharness.runner.recorder import TrialRecorder
+
+    task = {t.task_id: t for t in published_tasks()}["airplane_toy-01"]
+    m = get_manager()
+    be = m.create("backend", backend)
+    item = InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired)
+    ctx = TrialContext(
+        item=item,
+        trial_index=1,
+        robot=m.create("robot", "allegro"),
+        backend=be,
+        sensors={},
+        rng=np.random.default_rng(0),
+        budget=TimeBudget(),
+        recorder=TrialRecorder(lambda: be.time),
+        physics=be.config,
+    )
+    try:
+        out = InGraspPlanner("relaxed-rigidity", max_iterations=5).run_trial(ctx)
+        assert be.time == 0.0  # refused before the first physics step
+    finally:
+        be.close()
+    assert out.failure == "unreachable"
+    assert "does not fit our airplane toy model" in out.message
+    assert "6.5 mm inside" in out.message
 
 
 def test_placement_touches_fingertips(planner, task):

@@ -12,7 +12,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from .config import VARIANTS, IngraspConfig
-from .execution import ExecConfig, InGraspExecutor
+from .execution import ExecConfig, InGraspExecutor, SetupInfeasible
 from .hand import HandKinematics
 from .planner import PlanResult, plan, tip_rotation_deg
 from .problem import InGraspProblem, problem_from_task
@@ -136,6 +136,13 @@ class InGraspPlanner:
             return TrialOutcome(
                 failure="simulator_error",
                 message=f"physics blow-up: {exc}",
+                plan_time_s=res.plan_time_s,
+                extra=extra,
+            )
+        except SetupInfeasible as exc:  # the grasp cannot be set up on our object model
+            return TrialOutcome(
+                failure="unreachable",
+                message=f"set-up infeasible: {exc}",
                 plan_time_s=res.plan_time_s,
                 extra=extra,
             )
