@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-__all__ = ["FINGERS", "TIP_LINKS", "HandKinematics"]
+__all__ = ["FINGERS", "TIP_LINKS", "HandKinematics", "default_urdf"]
 
 DTYPE = torch.float64
 #: Benchmark finger numbering (dataset column ``fingers``) -> name.
@@ -31,7 +31,8 @@ TIP_LINKS = {
 }
 
 
-def _default_urdf() -> Path:
+def default_urdf() -> Path:
+    """The Allegro description the in-grasp planner and its set-up placement read (``robots/allegro``)."""
     from benchharness.paths import robots_dir
 
     return robots_dir() / "allegro" / "allegro.urdf"
@@ -50,7 +51,7 @@ class HandKinematics:
             import pytorch_kinematics as pk
 
             text = (
-                Path(urdf or _default_urdf()).read_text()
+                Path(urdf or default_urdf()).read_text()
                 if not str(urdf or "").lstrip().startswith("<")
                 else str(urdf)
             )

@@ -38,7 +38,7 @@ from scipy.optimize import least_squares
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from .hand import DTYPE, FINGERS, TIP_LINKS, HandKinematics
+from .hand import DTYPE, FINGERS, TIP_LINKS, HandKinematics, default_urdf
 
 __all__ = ["InGraspPlacement", "HandGeometry", "hand_geometry", "place_object"]
 
@@ -88,9 +88,7 @@ def _origin(el: ET.Element | None) -> np.ndarray:
 @lru_cache(maxsize=4)
 def hand_geometry(urdf: str | None = None) -> HandGeometry:
     """Collision boxes and spheres of every link of the Allegro URDF (primitive shapes only)."""
-    from .hand import _default_urdf
-
-    root = ET.parse(str(urdf or _default_urdf())).getroot()
+    root = ET.parse(str(urdf or default_urdf())).getroot()
     boxes: dict[str, list] = {}
     spheres: dict[str, list] = {}
     for link in root.findall("link"):
