@@ -134,13 +134,27 @@ def test_same_seed_same_result(planner, task, plan):
     )  # the noise comes from the rng
 
 
-def test_blow_up_is_reported_not_raised(task):
-    """A SimulationError inside the trial becomes a TrialOutcome with cause simulator_error."""
+def _trial_context(task, be):
+    """The runner's context for one trial of ``task`` on the Allegro in backend ``be`` (seed 0)."""
     from benchharness.runner.contract import InhandItem, TimeBudget, TrialContext
     from benchharness.runner.recorder import TrialRecorder
 
-    m = get_manager()
-    be = m.create("backend", "pybullet")
+    return TrialContext(
+        item=InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired),
+        trial_index=1,
+        robot=get_manager().create("robot", "allegro"),
+        backend=be,
+        sensors={},
+        rng=np.random.default_rng(0),
+        budget=TimeBudget(),
+        recorder=TrialRecorder(lambda: be.time),
+        physics=be.config,
+    )
+
+
+def test_blow_up_is_reported_not_raised(task):
+    """A SimulationError inside the trial becomes a TrialOutcome with cause simulator_error."""
+    be = get_manager().create("backend", "pybullet")
     steps = {"n": 0}
 
     def blow_up_after_40_steps() -> None:  # a step callback: exceptions propagate out of step()
@@ -149,23 +163,11 @@ def test_blow_up_is_reported_not_raised(task):
             raise SimulationError("injected blow-up")
 
     be.add_step_callback(blow_up_after_40_steps)
-    item = InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired)
-    ctx = TrialContext(
-        item=item,
-        trial_index=1,
-        robot=m.create("robot", "allegro"),
-        backend=be,
-        sensors={},
-        rng=np.random.default_rng(0),
-        budget=TimeBudget(),
-        recorder=TrialRecorder(lambda: be.time),
-        physics=be.config,
-    )
     planner = InGraspPlanner(
         "relaxed-rigidity", max_iterations=5
     )  # plan quality is irrelevant here
     try:
-        out = planner.run_trial(ctx)
+        out = planner.run_trial(_trial_context(task, be))
     finally:
         be.close()
     assert out.failure == "simulator_error"
@@ -218,26 +220,12 @@ def test_a_grasp_that_does_not_fit_the_object_is_refused_before_any_physics(back
     airplane at 7-14 m/s (``simulator_error``) and PyBullet scored trials that began from the
     interpenetration; the trial now ends ``unreachable`` with that depth, before the engine steps.
     """
-    from benchharness.runner.contract import InhandItem, TimeBudget, TrialContext
-    from benchharness.runner.recorder import TrialRecorder
-
     task = {t.task_id: t for t in published_tasks()}["airplane_toy-01"]
-    m = get_manager()
-    be = m.create("backend", backend)
-    item = InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired)
-    ctx = TrialContext(
-        item=item,
-        trial_index=1,
-        robot=m.create("robot", "allegro"),
-        backend=be,
-        sensors={},
-        rng=np.random.default_rng(0),
-        budget=TimeBudget(),
-        recorder=TrialRecorder(lambda: be.time),
-        physics=be.config,
-    )
+    be = get_manager().create("backend", backend)
     try:
-        out = InGraspPlanner("relaxed-rigidity", max_iterations=5).run_trial(ctx)
+        out = InGraspPlanner("relaxed-rigidity", max_iterations=5).run_trial(
+            _trial_context(task, be)
+        )
         assert be.time == 0.0  # refused before the first physics step
     finally:
         be.close()
