@@ -123,7 +123,7 @@ class ExecConfig:
     #: object; deeper, the published grasp does not fit our model of the object and the trial is refused
     #: before any physics (unreachable): the engines would otherwise start from an interpenetration
     #: (SAPIEN ejected the airplane toy at 7-14 m/s). 1 mm is the tolerance of "a valid grasp of the
-    #: scan" in docs/objects.md; only the airplane toy's grasps exceed it (5.8, 6.5 mm)
+    #: scan" in docs/objects.md; only the airplane toy's grasps exceed it (5.9, 6.5 mm)
     max_placement_penetration: float = 0.001
     #: friction cone half angle (deg) the set-up placement keeps the squeeze directions inside
     #: (``placement.place_object``). ``"friction"`` (default): ``atan(mu)`` of the fingertip-object
