@@ -34,7 +34,7 @@ import numpy as np
 from benchharness.objects import load_object
 from benchharness.robots.descriptions.allegro import TIP_R
 from benchharness.strategies.ingrasp.hand import HandKinematics
-from benchharness.strategies.ingrasp.tasks import published_tasks
+from benchharness.strategies.ingrasp.tasks import distinct_initial_grasps
 
 ROUND = ("apple", "orange")
 BINS = (30.0, 38.0, 42.0)  #: edges of the grip-angle bins (deg)
@@ -65,21 +65,9 @@ def published_grasps() -> None:
         "initial grasp (task)           fingers            tip-centre distances (mm)   circle rho (mm)"
         "   ball R (mm)   predicted tilt acos(rho/(R+r))"
     )
-    seen: set[tuple] = set()
-    for task in published_tasks():
-        key = (task.object, tuple(np.round(task.q0_published, 6)))
-        if key in seen:
-            continue
-        seen.add(key)
-        fingers = sorted(task.fingers, key=("index", "middle", "ring", "thumb").index)
-        q = np.concatenate(
-            [
-                task.q0_published[4 * i : 4 * i + 4]
-                for i, f in enumerate(("index", "middle", "ring", "thumb"))
-                if f in fingers
-            ]
-        )
-        tips = kin.tip_poses_np(q, fingers)[0, :, :3, 3]
+    for task in distinct_initial_grasps():
+        fingers = task.hand_fingers
+        tips = kin.tip_poses_np(task.q0_used, fingers)[0, :, :3, 3]
         d = [1000 * float(np.linalg.norm(tips[i] - tips[j])) for i, j in ((0, 1), (0, 2), (1, 2))]
         rho = circumradius(tips)
         row = f"{task.task_id:<30s} {'+'.join(fingers):<18s} {' / '.join(f'{x:5.1f}' for x in d):<27s} {1000 * rho:8.1f}"

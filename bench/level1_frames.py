@@ -24,8 +24,8 @@ from scipy.spatial.transform import Rotation
 
 from benchharness.objects import load_object
 from benchharness.robots.descriptions.allegro import TIP_R
-from benchharness.strategies.ingrasp.hand import FINGERS, HandKinematics
-from benchharness.strategies.ingrasp.tasks import published_level1_path, published_tasks
+from benchharness.strategies.ingrasp.hand import HandKinematics
+from benchharness.strategies.ingrasp.tasks import distinct_initial_grasps, published_level1_path
 
 #: where the scan's origin lies in the tracked frame, per convention (R: the scan's rotation there)
 CONVENTIONS = {
@@ -46,22 +46,13 @@ def main() -> None:
     kin = HandKinematics()
     rotations = [r.as_matrix() for r in Rotation.create_group("O")]
     meshes: dict[str, trimesh.Trimesh] = {}
-    seen: set[tuple] = set()
     per_object: dict[str, list[dict[tuple[int, str], float]]] = {}
     print("grasp                          best: gap mm, rotation, offset   runner-up")
-    for task in published_tasks():
-        key = (task.object, tuple(np.round(task.q0_published, 6)))
-        if key in seen:
-            continue
-        seen.add(key)
+    for task in distinct_initial_grasps():
         if task.object not in meshes:
             s = load_object(task.object).surface
             meshes[task.object] = trimesh.Trimesh(np.asarray(s.vertices), np.asarray(s.faces))
-        fingers = sorted(task.fingers, key=FINGERS.index)
-        q = np.concatenate(
-            [task.q0_published[4 * FINGERS.index(f) : 4 * FINGERS.index(f) + 4] for f in fingers]
-        )
-        tips = kin.tip_poses_np(q, fingers)[0, :, :3, 3]  # palm frame
+        tips = kin.tip_poses_np(task.q0_used, task.hand_fingers)[0, :, :3, 3]  # palm frame
         tracked = (np.linalg.inv(task.initial_matrix) @ np.c_[tips, np.ones(len(tips))].T).T[:, :3]
         off = offsets[task.task_id]
         fits = []

@@ -96,6 +96,24 @@ def _tip_distance_change(hand, p, q):
     return float(np.abs(d - d[0]).max())
 
 
+def test_used_fingers_and_their_published_joints_as_the_file_gives_them(tasks):
+    """``hand_fingers``/``q0_used`` against the published file's own columns (``fingers``: 0 index ... 3
+    thumb; ``grasp_<finger>_j<k>``), read here with the csv module, not through ``published_tasks``."""
+    import csv
+
+    from benchharness.strategies.ingrasp.tasks import published_level1_path
+
+    with open(published_level1_path(), newline="") as fh:
+        rows = {r["task_id"]: r for r in csv.DictReader(fh)}
+    for t in tasks:
+        row = rows[t.task_id]
+        used = sorted(int(x) for x in row["fingers"].split(";"))
+        names = [("index", "middle", "ring", "thumb")[i] for i in used]
+        assert t.hand_fingers == tuple(names)
+        expected = [float(row[f"grasp_{f}_j{k}"]) for f in names for k in range(4)]
+        assert t.q0_used.tolist() == expected
+
+
 def test_rigid_goal_is_reached_without_changing_the_grasp(hand, tasks):
     """A goal reachable by pure rigid motion: relaxed-rigidity reaches it and the fingertip
     distances (the grasp) change by well under a millimetre along the whole trajectory."""

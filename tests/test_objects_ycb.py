@@ -163,15 +163,9 @@ AIRPLANE = ("airplane_toy-01", "airplane_toy-06")
 
 
 def _level1_grasps():
-    from benchharness.strategies.ingrasp.tasks import published_tasks
+    from benchharness.strategies.ingrasp.tasks import distinct_initial_grasps
 
-    seen, out = set(), []
-    for t in published_tasks():
-        key = (t.object, tuple(np.round(t.q0_published, 6)))
-        if key not in seen:
-            seen.add(key)
-            out.append(t)
-    return out
+    return distinct_initial_grasps()
 
 
 def _check_grasp(task_id: str):

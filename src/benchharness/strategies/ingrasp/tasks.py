@@ -18,6 +18,7 @@ the initial grasp in our ``palm_link`` frame, see ``docs/ingrasp.md``), so:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,7 +27,7 @@ import numpy as np
 from .hand import FINGERS
 from .rotations import pose_matrix
 
-__all__ = ["InGraspTask", "published_tasks", "published_level1_path"]
+__all__ = ["InGraspTask", "distinct_initial_grasps", "published_tasks", "published_level1_path"]
 
 
 def published_level1_path() -> Path:
@@ -51,6 +52,22 @@ class InGraspTask:
     def initial_matrix(self) -> np.ndarray:
         return pose_matrix(self.initial)
 
+    @property
+    def hand_fingers(self) -> tuple[str, ...]:
+        """The fingers used, in the hand's order (index, middle, ring, thumb)."""
+        return tuple(f for f in FINGERS if f in self.fingers)
+
+    @property
+    def q0_used(self) -> np.ndarray:
+        """The used fingers' published joints (unclamped), in :attr:`hand_fingers` order: what
+        ``HandKinematics.tip_poses_np(q0_used, hand_fingers)`` reads."""
+        return np.concatenate(
+            [
+                self.q0_published[4 * FINGERS.index(f) : 4 * FINGERS.index(f) + 4]
+                for f in self.hand_fingers
+            ]
+        )
+
     def goal_matrix(self, initial_rob: np.ndarray | None = None) -> np.ndarray:
         """``(H_d H_i^-1) H_i^rob``; ``initial_rob`` defaults to ``H_i`` (then the goal is ``H_d``)."""
         hi, hd = pose_matrix(self.initial), pose_matrix(self.desired)
@@ -64,6 +81,21 @@ def _order(fingers: list[int], reference: str) -> tuple[str, ...]:
         names.remove(reference)
         names.insert(0, reference)
     return tuple(names)
+
+
+def distinct_initial_grasps(tasks: Sequence[InGraspTask] | None = None) -> list[InGraspTask]:
+    """The first task of each distinct initial grasp (object and published joint vector).
+
+    The published file sets two grasps per object, each shared by five tasks: 20 of the 100.
+    """
+    seen: set[tuple] = set()
+    out = []
+    for t in published_tasks() if tasks is None else tasks:
+        key = (t.object, tuple(np.round(t.q0_published, 6)))
+        if key not in seen:
+            seen.add(key)
+            out.append(t)
+    return out
 
 
 def published_tasks(path: str | Path | None = None, reference: str = "index") -> list[InGraspTask]:
