@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 import torch
+from ingrasp_helpers import trial_context
 
 from benchharness.backends.interface import PhysicsConfig, SimulationError
 from benchharness.plugin import get_manager
@@ -134,24 +135,6 @@ def test_same_seed_same_result(planner, task, plan):
     )  # the noise comes from the rng
 
 
-def _trial_context(task, be):
-    """The runner's context for one trial of ``task`` on the Allegro in backend ``be`` (seed 0)."""
-    from benchharness.runner.contract import InhandItem, TimeBudget, TrialContext
-    from benchharness.runner.recorder import TrialRecorder
-
-    return TrialContext(
-        item=InhandItem("inhand-level1", task.task_id, task.object, 1, task.initial, task.desired),
-        trial_index=1,
-        robot=get_manager().create("robot", "allegro"),
-        backend=be,
-        sensors={},
-        rng=np.random.default_rng(0),
-        budget=TimeBudget(),
-        recorder=TrialRecorder(lambda: be.time),
-        physics=be.config,
-    )
-
-
 def test_blow_up_is_reported_not_raised(task):
     """A SimulationError inside the trial becomes a TrialOutcome with cause simulator_error."""
     be = get_manager().create("backend", "pybullet")
@@ -167,7 +150,7 @@ def test_blow_up_is_reported_not_raised(task):
         "relaxed-rigidity", max_iterations=5
     )  # plan quality is irrelevant here
     try:
-        out = planner.run_trial(_trial_context(task, be))
+        out = planner.run_trial(trial_context(task, be))
     finally:
         be.close()
     assert out.failure == "simulator_error"
@@ -212,26 +195,31 @@ def test_config_validation():
 
 
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])
-def test_a_grasp_that_does_not_fit_the_object_is_refused_before_any_physics(backend):
+@pytest.mark.parametrize("grasp_q0, depth", [("contact", "6.5"), ("command", "7.8")])
+def test_a_grasp_that_does_not_fit_the_object_is_refused_before_any_physics(
+    backend, grasp_q0, depth
+):
     """airplane_toy-01: at the best placement the hand is 6.5 mm inside our airplane model.
 
-    The reference is the placement's own measure (``tests/test_objects_ycb.py`` holds it strictly:
-    6.51 mm, a strict xfail of "a valid grasp of the scan"). Simulated anyway, SAPIEN ejected the
-    airplane at 7-14 m/s (``simulator_error``) and PyBullet scored trials that began from the
-    interpenetration; the trial now ends ``unreachable`` with that depth, before the engine steps.
+    The reference is the placement's own measure at the published angles (``tests/test_objects_ycb.py``
+    holds it strictly: 6.51 mm, a strict xfail of "a valid grasp of the scan"); touching where the
+    squeeze holds the fingers back from them (``grasp_q0="command"``, the default) it is 7.8 mm.
+    Simulated anyway, SAPIEN ejected the airplane at 7-14 m/s (``simulator_error``) and PyBullet
+    scored trials that began from the interpenetration; the trial now ends ``unreachable`` with that
+    depth, before the engine steps.
     """
     task = {t.task_id: t for t in published_tasks()}["airplane_toy-01"]
     be = get_manager().create("backend", backend)
     try:
-        out = InGraspPlanner("relaxed-rigidity", max_iterations=5).run_trial(
-            _trial_context(task, be)
-        )
+        out = InGraspPlanner(
+            "relaxed-rigidity", max_iterations=5, exec_config=ExecConfig(grasp_q0=grasp_q0)
+        ).run_trial(trial_context(task, be))
         assert be.time == 0.0  # refused before the first physics step
     finally:
         be.close()
     assert out.failure == "unreachable"
     assert "does not fit our airplane toy model" in out.message
-    assert "6.5 mm inside" in out.message
+    assert f"{depth} mm inside" in out.message
 
 
 def test_placement_touches_fingertips(planner, task):
@@ -406,7 +394,11 @@ def test_setup_holds_banana_06(backend):
     out = _run(planner, t, plan, backend)
     assert not out.dropped, out.message
     assert out.extra["setup_tip_contacts"] == ["link_15_tip", "link_3_tip", "link_7_tip"]
-    before = _run(
-        planner, t, plan, backend, config=ExecConfig(hold_s=0.2, placement_grip_cone_deg=None)
+    before = _run(  # the set-up as it was: contacts only, the fingertips touching at q_0
+        planner,
+        t,
+        plan,
+        backend,
+        config=ExecConfig(hold_s=0.2, placement_grip_cone_deg=None, grasp_q0="contact"),
     )
     assert before.dropped and before.phase == "setup", before.message

@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
@@ -137,10 +138,21 @@ class ExecConfig:
     #: middle carry ~0.05 N m of finger weight against a ~0.13 N m squeeze). False: plain PD (before
     #: 2026-12-02). docs/ingrasp.md, "Execution drops"
     gravity_compensation: bool = True
+    #: what the published initial grasp ``q_0`` is. ``"command"`` (default): the joint set-point the
+    #: grasp was commanded at (the file types every grasp joint to at most two decimals, 97 % of them
+    #: multiples of 0.1 rad, where its measured poses carry ten: set-points, not encoder readings);
+    #: a PD hand squeezing an object stops short of it, so the fingertips touch the object at
+    #: ``q_c = q_0 - K^-1 J^T f(q_c)`` (:func:`touch_configuration`), the object is placed there, and
+    #: the set-up and the plan's first target command ``q_0`` itself. ``"contact"``: the fingertips
+    #: touch at ``q_0`` and the squeeze is commanded beyond it (before 2026-12-04). docs/ingrasp.md,
+    #: "What the published grasp is"
+    grasp_q0: Literal["contact", "command"] = "command"
 
     def __post_init__(self) -> None:
         if self.palm not in PALM_ROTATIONS:
             raise ValueError(f"palm must be one of {', '.join(PALM_ROTATIONS)}, not {self.palm!r}")
+        if self.grasp_q0 not in ("contact", "command"):
+            raise ValueError(f"grasp_q0 must be 'contact' or 'command', not {self.grasp_q0!r}")
         for name in (
             "hand_height",
             "control_period",
@@ -231,6 +243,31 @@ def squeeze_offsets(
     return tau / np.asarray(stiffness, float)
 
 
+def touch_configuration(
+    hand: HandKinematics,
+    q0: np.ndarray,
+    idx: np.ndarray,
+    fingers: tuple[str, ...],
+    force: float,
+    stiffness: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    iterations: int = 8,
+) -> np.ndarray:
+    """Where fingers commanded to ``q0`` stop on an object they squeeze with mean ``force`` N.
+
+    A joint PD drive of stiffness ``K`` commanded to ``q0`` holds a fingertip force ``f`` at
+    ``q_c = q0 - K^-1 J(q_c)^T f(q_c)`` (the squeeze of :func:`squeeze_offsets`), solved by fixed
+    point from ``q0`` (each step moves less than a milliradian after three); 16 joints in and out,
+    only ``idx`` (the used fingers') changed, kept inside ``lower``..``upper``.
+    """
+    q = np.asarray(q0, float).copy()
+    for _ in range(iterations):
+        q[idx] = q0[idx] - squeeze_offsets(hand, q[idx], fingers, force, stiffness)
+        q = np.clip(q, lower, upper)
+    return q
+
+
 def backoff_offsets(
     hand: HandKinematics, q: np.ndarray, fingers: tuple[str, ...], distance: float
 ) -> np.ndarray:
@@ -290,15 +327,21 @@ class InGraspExecutor:
         return float(backend.pair_friction(obj_mu, hand_mu))
 
     def placement(
-        self, problem: InGraspProblem, object_name: str, friction: float = 1.0
+        self,
+        problem: InGraspProblem,
+        object_name: str,
+        friction: float = 1.0,
+        q_touch: np.ndarray | None = None,
     ) -> InGraspPlacement:
-        """Where the (noise-free) object sits at ``q_0`` for a contact friction ``friction``; cached
-        per task, object and friction cone."""
+        """Where the (noise-free) object sits when the fingertips touch it at ``q_touch`` (default
+        ``q_0``) for a contact friction ``friction``; cached per hand, task, object, joints and
+        friction cone."""
+        q = problem.q_rest if q_touch is None else q_touch
         return _cached_placement(
             self.hand,
             problem.task_id,
             object_name,
-            tuple(np.round(problem.q_rest, 12)),
+            tuple(np.round(q, 12)),
             problem.fingers,
             self.grip_cone_deg(friction),
         )
@@ -334,9 +377,33 @@ class InGraspExecutor:
                 "in-grasp execution needs the allegro robot (a 16-joint 'hand' joint_0..joint_15), "
                 f"got {getattr(robot, 'name', robot)!r}"
             )
+        robot_urdf = getattr(robot, "urdf_path", None)
+        if (
+            self.hand.urdf_path is not None
+            and robot_urdf is not None
+            and Path(self.hand.urdf_path).resolve() != Path(robot_urdf).resolve()
+        ):  # a plan and set-up for one hand executed on another would put the fingertips elsewhere
+            raise ValueError(
+                f"the planning hand model ({self.hand.urdf_path}) is not the simulated robot's "
+                f"description ({robot_urdf})"
+            )
         wall0 = time.perf_counter()
+        hand_grip = robot.gripper("hand")
+        kp = np.asarray(hand_grip.config.stiffness, float)
+        idx = np.concatenate(
+            [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in problem.fingers]
+        )
+        lo, hi = hand_grip.lower, hand_grip.upper
+        q0 = problem.q_rest.copy()
+        q_touch = (
+            touch_configuration(
+                self.hand, q0, idx, problem.fingers, cfg.squeeze_force, kp[idx], lo, hi
+            )
+            if cfg.grasp_q0 == "command"
+            else q0.copy()
+        )
         mu = self.contact_friction(backend)
-        place = self.placement(problem, object_name, mu)
+        place = self.placement(problem, object_name, mu, q_touch)
         if place.max_gap > cfg.max_placement_gap:
             raise SetupInfeasible(
                 f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
@@ -351,17 +418,10 @@ class InGraspExecutor:
         wall_place = time.perf_counter() - wall0
         model = load_object(object_name)
 
-        hand_grip = robot.gripper("hand")
-        kp = np.asarray(hand_grip.config.stiffness, float)
-        idx = np.concatenate(
-            [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in problem.fingers]
-        )
-        q0 = problem.q_rest.copy()
         sq0 = squeeze_offsets(self.hand, q0[idx], problem.fingers, cfg.squeeze_force, kp[idx])
-        back = backoff_offsets(self.hand, q0[idx], problem.fingers, cfg.preshape_open)
-        q_pre = q0.copy()
+        back = backoff_offsets(self.hand, q_touch[idx], problem.fingers, cfg.preshape_open)
+        q_pre = q_touch.copy()
         q_pre[idx] += back
-        lo, hi = hand_grip.lower, hand_grip.upper
         q_pre = np.clip(q_pre, lo, hi)
 
         # the world: ground, hand fixed in space, object
@@ -402,6 +462,8 @@ class InGraspExecutor:
             "placement_penetration_mm": round(place.penetration * 1e3, 3),
             "placement_rotation_change_deg": round(place.rotation_change_deg, 3),
             "placement_grip_angles_deg": np.round(place.grip_angles_deg, 1).tolist(),
+            # how far (rad, largest joint) the fingertips touch from the published q_0 (grasp_q0)
+            "touch_offset_rad": round(float(np.max(np.abs(q0 - q_touch))), 5),
             "contact_friction": round(mu, 6),
             "placement_grip_cone_deg": self.grip_cone_deg(mu),
             "setup_noise_pos_mm": (dp * 1e3).round(4).tolist(),
@@ -413,7 +475,7 @@ class InGraspExecutor:
         t_start = float(backend.time)
         per = max(1, int(round(cfg.control_period / backend.config.timestep)))
         tip_links = {TIP_LINKS[f] for f in problem.fingers}
-        tips0 = self.hand.tip_poses_np(q0[idx][None], problem.fingers)[0][:, :3, 3]
+        tips0 = self.hand.tip_poses_np(q_touch[idx][None], problem.fingers)[0][:, :3, 3]
         state = {
             "last_contact": float(backend.time),
             "checked": float(backend.time),
@@ -481,8 +543,10 @@ class InGraspExecutor:
                     state["checked"] = float(backend.time)
                     check(active)
 
+        # the set-up's closing target: q_0 plus the squeeze, or (grasp_q0 "command") q_0 itself
         q_closed = q0.copy()
-        q_closed[idx] += sq0
+        if cfg.grasp_q0 == "contact":
+            q_closed[idx] += sq0
         phase = "setup"
         exec_sim = 0.0
         reached_m = None
@@ -512,7 +576,7 @@ class InGraspExecutor:
                     forces[c.link_b] += float(c.normal_force)
             extra["setup_tip_forces_n"] = {k: round(v, 4) for k, v in forces.items()}
             extra["setup_joint_error_rad"] = round(
-                float(np.max(np.abs(robot.joint_positions()[idx] - q0[idx]))), 5
+                float(np.max(np.abs(robot.joint_positions()[idx] - q_touch[idx]))), 5
             )
             if recorder is not None:
                 recorder.event(
@@ -534,6 +598,8 @@ class InGraspExecutor:
                     for w in range(n_wp + 1)
                 ]
             )
+            if cfg.grasp_q0 == "command":  # the first target is q_0 itself (the squeeze's origin)
+                offs = offs - offs[0]
             targets = traj.copy()
             targets[:, idx] += offs
 
@@ -601,7 +667,7 @@ def _cached_placement(
 ) -> InGraspPlacement:
     from benchharness.objects import load_object
 
-    key = (task_id, object_name, q_rest, fingers, grip_cone_deg)
+    key = (hand.urdf_path, task_id, object_name, q_rest, fingers, grip_cone_deg)
     if key not in _PLACEMENTS:
         v, n, c, sym = object_surface_arrays(load_object(object_name))
         _PLACEMENTS[key] = place_object(

@@ -50,11 +50,11 @@ class HandKinematics:
             warnings.simplefilter("ignore")
             import pytorch_kinematics as pk
 
-            text = (
-                Path(urdf or default_urdf()).read_text()
-                if not str(urdf or "").lstrip().startswith("<")
-                else str(urdf)
-            )
+            from_text = str(urdf or "").lstrip().startswith("<")
+            #: the description file (None when built from URDF text): the set-up placement reads
+            #: the same file's collision shapes
+            self.urdf_path: str | None = None if from_text else str(urdf or default_urdf())
+            text = str(urdf) if from_text else Path(str(self.urdf_path)).read_text()
             self.fingers = tuple(fingers)
             self.chains = {
                 f: pk.build_serial_chain_from_urdf(text.encode(), TIP_LINKS[f], "palm_link").to(

@@ -178,7 +178,7 @@ def place_object(
     the squeeze only slides along, and the grip ejects the object as soon as
     it is released (docs/ingrasp.md, "Set-up drops").
     """
-    geo = hand_geometry(urdf)
+    geo = hand_geometry(urdf or hand.urdf_path)
     frames = link_frames(hand, q16)
     tips_used = {TIP_LINKS[f] for f in fingers}
     tip_c, tip_r = [], []

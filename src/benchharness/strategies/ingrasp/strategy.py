@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .config import VARIANTS, IngraspConfig
 from .execution import ExecConfig, InGraspExecutor, SetupInfeasible
-from .hand import HandKinematics
+from .hand import HandKinematics, default_urdf
 from .planner import PlanResult, plan, tip_rotation_deg
 from .problem import InGraspProblem, problem_from_task
 from .tasks import InGraspTask, published_tasks
@@ -21,10 +21,15 @@ from .tasks import InGraspTask, published_tasks
 __all__ = ["InGraspPlanner", "task_for_item"]
 
 
-@lru_cache(maxsize=1)
-def _shared_hand() -> HandKinematics:
-    """One hand model per process (URDF parsing costs more than a plan); trials share it read-only."""
-    return HandKinematics()
+def _shared_hand(urdf: str | Path | None = None) -> HandKinematics:
+    """One hand model per description file and process (URDF parsing costs more than a plan);
+    trials share it read-only. ``None``: the stock Allegro (``robots/allegro``)."""
+    return _hand_at(str(Path(urdf or default_urdf()).resolve()))
+
+
+@lru_cache(maxsize=4)
+def _hand_at(path: str) -> HandKinematics:
+    return HandKinematics(path)
 
 
 @lru_cache(maxsize=1)
@@ -59,8 +64,9 @@ def task_for_item(item) -> InGraspTask:
 class InGraspPlanner:
     """Plans (and, as a runner strategy, executes) Level I in-grasp trajectories on the Allegro.
 
-    The hand model is built once per process unless ``urdf``/``hand`` is
-    given; ``exec_config`` sets up the simulated trials (:class:`ExecConfig`).
+    The hand model is the trial robot's own description (``allegro`` or ``allegro-biotac``), built
+    once per process, unless ``urdf``/``hand`` fixes one; offline planning (:meth:`plan_task`) uses
+    that or the stock Allegro. ``exec_config`` sets up the simulated trials (:class:`ExecConfig`).
     """
 
     benchmarks = ("inhand",)
@@ -80,13 +86,22 @@ class InGraspPlanner:
         self.name = variant
         self.config = replace(config or IngraspConfig(), **overrides)
         self.exec_config = exec_config or ExecConfig()
-        self.hand = hand or (HandKinematics(urdf) if urdf is not None else _shared_hand())
+        self._fixed_hand = hand or (HandKinematics(urdf) if urdf is not None else None)
 
-    def problem(self, task: InGraspTask) -> InGraspProblem:
-        return problem_from_task(task, self.hand, self.config.limit_margin)
+    @property
+    def hand(self) -> HandKinematics:
+        """The hand model offline planning uses: the one given, else the stock Allegro."""
+        return self._fixed_hand or _shared_hand()
 
-    def plan(self, problem: InGraspProblem) -> PlanResult:
-        return plan(self.hand, problem, self.variant, self.config)
+    def hand_for(self, robot) -> HandKinematics:
+        """The hand model of a trial's ``robot``: its own URDF unless one was fixed at construction."""
+        return self._fixed_hand or _shared_hand(robot.urdf_path)
+
+    def problem(self, task: InGraspTask, hand: HandKinematics | None = None) -> InGraspProblem:
+        return problem_from_task(task, hand or self.hand, self.config.limit_margin)
+
+    def plan(self, problem: InGraspProblem, hand: HandKinematics | None = None) -> PlanResult:
+        return plan(hand or self.hand, problem, self.variant, self.config)
 
     def plan_task(self, task: InGraspTask) -> PlanResult:
         return self.plan(self.problem(task))
@@ -100,8 +115,9 @@ class InGraspPlanner:
         from benchharness.runner.contract import TrialOutcome
 
         task = task_for_item(ctx.item)
-        problem = self.problem(task)
-        res = self.plan(problem)
+        hand = self.hand_for(ctx.robot)
+        problem = self.problem(task, hand)
+        res = self.plan(problem, hand)
         ctx.check_budget()
         ctx.recorder.event(
             "plan",
@@ -117,10 +133,10 @@ class InGraspPlanner:
             "plan_converged": res.converged,
             # per used finger: how far the plan turns the fingertip against the object (rolls it)
             "plan_tip_rotation_deg": np.round(
-                tip_rotation_deg(self.hand, problem.fingers, res.q), 2
+                tip_rotation_deg(hand, problem.fingers, res.q), 2
             ).tolist(),
         }
-        executor = InGraspExecutor(self.hand, self.exec_config)
+        executor = InGraspExecutor(hand, self.exec_config)
         try:
             out = executor.run(
                 ctx.backend,
