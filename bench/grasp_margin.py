@@ -9,7 +9,10 @@ each contact normal is tilted out of that plane by acos(rho / (R + r)). A squeez
 tips then acts at about that angle to every normal, and the grasp holds only while it is inside the
 friction cone (45 deg at the friction 1.0 we simulate).
 
-Part 1 prints, from the published file and the hand model alone (no physics), each distinct initial
+Part 1 reads the published angles as the configuration at which the fingertips touch (the set-up's
+``grasp_q0="contact"``; the default ``"command"`` touches where the squeeze holds the fingers back from
+them, and ``bench/hand_models.py`` measures both). It prints, from the published file and the hand
+model alone (no physics), each distinct initial
 grasp's fingertip circle and, for the near-spherical scans (apple, orange: least-squares ball fitted
 to the scan), the predicted tilt. Part 2 (``--store``, any number of stores written by ``run`` on
 ``inhand-level1``) counts each engine's and method's scored trials (set-up within the 10 % rule) and

@@ -5,16 +5,18 @@ interface only (so it runs on PyBullet and SAPIEN alike):
 
 1. **Set-up.** The hand is fixed in space, palm up by default
    (:attr:`ExecConfig.palm`; why: ``docs/ingrasp.md``, "Why palm up"). Our model of the task's object is placed where
-   the fingertips of the initial grasp ``q_0`` touch its surface
-   (:mod:`.placement`), then displaced by the set-up noise (drawn from
-   ``ctx.rng``), and held there by a fixed constraint to the palm (the
+   the fingertips touch its surface at ``q_c``, where fingers commanded to the published
+   grasp ``q_0`` stop against the squeeze (:attr:`ExecConfig.grasp_q0`, :func:`touch_configuration`;
+   ``q_c = q_0`` with ``"contact"``) (:mod:`.placement`), then displaced by the set-up noise (drawn
+   from ``ctx.rng``), and held there by a fixed constraint to the palm (the
    "human" of the protocol) while the fingers, opened
    :attr:`ExecConfig.preshape_open` away from the surface, close onto it
-   with the squeeze offset. The constraint is removed, the grasp settles,
-   and the achieved object pose is the set-up pose.
+   commanded to ``q_0`` (``"contact"``: ``q_0`` plus the squeeze offset). The constraint is
+   removed, the grasp settles, and the achieved object pose is the set-up pose.
 2. **Execution.** The planned joint trajectory, linearly interpolated
    between its waypoints over the plan's duration (1.67 s), plus the squeeze
-   offset, is sent as joint position targets every control period.
+   offset's change from ``q_0`` (``"contact"``: plus the squeeze offset), is sent as joint
+   position targets every control period.
 3. **Stability check.** The last target is held for
    :attr:`ExecConfig.hold_s` (5 s) with nothing but the hand touching the
    object; the object's drift over the hold is reported.
@@ -25,8 +27,8 @@ touches anything but the hand (the ground), or when its centre gets
 :attr:`ExecConfig.drop_distance` farther from the fingertip centroid than
 at the grasp.
 
-**Squeeze.** A plan is kinematic: at ``q_0`` the fingertips just touch the
-object and no force holds it. Each used fingertip is therefore given an
+**Squeeze.** A plan is kinematic: no force in it holds the object. Each used fingertip is
+therefore given an
 internal force ``f_i = s (g - p_i)`` towards the centroid ``g`` of the used
 fingertip centres ``p_i``, scaled so the mean force is
 :attr:`ExecConfig.squeeze_force`. These forces sum to zero and have zero
