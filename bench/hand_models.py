@@ -34,7 +34,7 @@ from benchharness.objects import load_object
 from benchharness.robots.allegro import KP
 from benchharness.robots.descriptions import allegro as descriptions
 from benchharness.strategies.ingrasp.execution import ExecConfig, touch_configuration
-from benchharness.strategies.ingrasp.hand import FINGERS, HandKinematics
+from benchharness.strategies.ingrasp.hand import FINGERS, HandKinematics, joint_indices
 from benchharness.strategies.ingrasp.placement import object_surface_arrays, place_object
 from benchharness.strategies.ingrasp.problem import clamp_grasp
 from benchharness.strategies.ingrasp.tasks import distinct_initial_grasps
@@ -85,12 +85,7 @@ def main() -> None:
                 v, n, c, sym = surfaces[task.object]
                 q, _ = clamp_grasp(task.q0_published, hand)
                 if reading == "command":
-                    idx = np.concatenate(
-                        [
-                            np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4)
-                            for f in task.hand_fingers
-                        ]
-                    )
+                    idx = joint_indices(task.hand_fingers)
                     q = touch_configuration(
                         hand, q, idx, task.hand_fingers, squeeze, np.full(len(idx), KP), lo, hi
                     )

@@ -21,7 +21,7 @@ from benchharness.strategies.ingrasp.execution import (
     InGraspExecutor,
     touch_configuration,
 )
-from benchharness.strategies.ingrasp.hand import FINGERS
+from benchharness.strategies.ingrasp.hand import FINGERS, joint_indices
 from benchharness.strategies.ingrasp.problem import problem_from_task
 from benchharness.strategies.ingrasp.strategy import InGraspPlanner, _shared_hand
 from benchharness.strategies.ingrasp.tasks import published_level1_path, published_tasks
@@ -58,9 +58,7 @@ def test_touch_configuration_balances_the_pd_drive(apple01):
     touch farther out than at ``q_0`` (the squeeze holds them back)."""
     hand = _shared_hand()
     p = problem_from_task(apple01, hand)
-    idx = np.concatenate(
-        [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in p.fingers]
-    )
+    idx = joint_indices(p.fingers)
     lo, hi = hand.limits(FINGERS)
     q0 = p.q_rest
     qc = touch_configuration(hand, q0, idx, p.fingers, 3.0, np.full(len(idx), KP), lo, hi)
@@ -91,9 +89,7 @@ def test_command_mode_sets_a_round_grasp_inside_the_friction_cone(apple01):
         p, apple01.object, 1.0
     )
     hand = planner.hand
-    idx = np.concatenate(
-        [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in p.fingers]
-    )
+    idx = joint_indices(p.fingers)
     lo, hi = hand.limits(FINGERS)
     qc = touch_configuration(hand, p.q_rest, idx, p.fingers, 3.0, np.full(len(idx), KP), lo, hi)
     command = InGraspExecutor(hand, ExecConfig(grasp_q0="command")).placement(

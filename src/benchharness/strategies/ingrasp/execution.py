@@ -65,7 +65,7 @@ import numpy as np
 import torch
 from scipy.spatial.transform import Rotation
 
-from .hand import DTYPE, FINGERS, TIP_LINKS, HandKinematics
+from .hand import DTYPE, TIP_LINKS, HandKinematics, joint_indices
 from .placement import InGraspPlacement, object_surface_arrays, place_object
 from .planner import PlanResult
 from .problem import InGraspProblem
@@ -392,9 +392,7 @@ class InGraspExecutor:
         wall0 = time.perf_counter()
         hand_grip = robot.gripper("hand")
         kp = np.asarray(hand_grip.config.stiffness, float)
-        idx = np.concatenate(
-            [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in problem.fingers]
-        )
+        idx = joint_indices(problem.fingers)
         lo, hi = hand_grip.lower, hand_grip.upper
         q0 = problem.q_rest.copy()
         q_touch = (

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-__all__ = ["FINGERS", "TIP_LINKS", "HandKinematics", "default_urdf"]
+__all__ = ["FINGERS", "TIP_LINKS", "HandKinematics", "default_urdf", "joint_indices"]
 
 DTYPE = torch.float64
 #: Benchmark finger numbering (dataset column ``fingers``) -> name.
@@ -29,6 +29,14 @@ TIP_LINKS = {
     "ring": "link_11_tip",
     "thumb": "link_15_tip",
 }
+
+
+def joint_indices(fingers: Sequence[str]) -> np.ndarray:
+    """Where ``fingers``' joints sit in the 16-joint hand vector (four per finger, in ``fingers``'
+    order; the hand's order is :data:`FINGERS`)."""
+    return np.concatenate(
+        [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in fingers]
+    )
 
 
 def default_urdf() -> Path:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .hand import FINGERS, HandKinematics
+from .hand import FINGERS, HandKinematics, joint_indices
 from .rotations import pose_matrix
 from .tasks import InGraspTask
 
@@ -50,9 +50,7 @@ def problem_from_task(
 ) -> InGraspProblem:
     """Our problem for a published task (see :mod:`.tasks` for the frame conventions)."""
     q16, moved = clamp_grasp(task.q0_published, hand, margin)
-    idx = np.concatenate(
-        [np.arange(4 * FINGERS.index(f), 4 * FINGERS.index(f) + 4) for f in task.fingers]
-    )
+    idx = joint_indices(task.fingers)
     h_i = pose_matrix(task.initial)
     return InGraspProblem(
         task.fingers, q16[idx], h_i, task.goal_matrix(h_i), q16, task.task_id, moved

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .hand import FINGERS
+from .hand import FINGERS, joint_indices
 from .rotations import pose_matrix
 
 __all__ = ["InGraspTask", "distinct_initial_grasps", "published_tasks", "published_level1_path"]
@@ -61,12 +61,7 @@ class InGraspTask:
     def q0_used(self) -> np.ndarray:
         """The used fingers' published joints (unclamped), in :attr:`hand_fingers` order: what
         ``HandKinematics.tip_poses_np(q0_used, hand_fingers)`` reads."""
-        return np.concatenate(
-            [
-                self.q0_published[4 * FINGERS.index(f) : 4 * FINGERS.index(f) + 4]
-                for f in self.hand_fingers
-            ]
-        )
+        return self.q0_published[joint_indices(self.hand_fingers)]
 
     def goal_matrix(self, initial_rob: np.ndarray | None = None) -> np.ndarray:
         """``(H_d H_i^-1) H_i^rob``; ``initial_rob`` defaults to ``H_i`` (then the goal is ``H_d``)."""
