@@ -34,7 +34,7 @@ from benchharness.objects import load_object
 from benchharness.robots.allegro import KP
 from benchharness.robots.descriptions import allegro as descriptions
 from benchharness.strategies.ingrasp.execution import ExecConfig, touch_configuration
-from benchharness.strategies.ingrasp.hand import FINGERS, HandKinematics, joint_indices
+from benchharness.strategies.ingrasp.hand import FINGERS, HandKinematics
 from benchharness.strategies.ingrasp.placement import object_surface_arrays, place_object
 from benchharness.strategies.ingrasp.problem import clamp_grasp
 from benchharness.strategies.ingrasp.tasks import distinct_initial_grasps
@@ -61,11 +61,11 @@ HANDS = {
 }
 CASES = [(h, "contact") for h in HANDS] + [("v4", "command")]
 CONE_DEG = 45.0  #: atan(1.0): the default fingertip-object friction
-GAP, PENETRATION = 0.002, 0.001  #: ExecConfig's set-up refusals (m)
 
 
 def main() -> None:
-    squeeze = ExecConfig().squeeze_force
+    cfg = ExecConfig()  # the set-up's squeeze and refusals (max_placement_gap / _penetration)
+    squeeze = cfg.squeeze_force
     surfaces = {}
     results: dict[tuple[str, str], list[tuple[str, bool, float]]] = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -85,14 +85,15 @@ def main() -> None:
                 v, n, c, sym = surfaces[task.object]
                 q, _ = clamp_grasp(task.q0_published, hand)
                 if reading == "command":
-                    idx = joint_indices(task.hand_fingers)
-                    q = touch_configuration(
-                        hand, q, idx, task.hand_fingers, squeeze, np.full(len(idx), KP), lo, hi
-                    )
+                    stiffness = np.full(4 * len(task.hand_fingers), KP)
+                    q = touch_configuration(hand, q, task.hand_fingers, squeeze, stiffness, lo, hi)
                 p = place_object(
                     hand, q, task.hand_fingers, v, n, c, symmetric=sym, grip_cone_deg=CONE_DEG
                 )
-                fits = p.max_gap <= GAP and p.penetration <= PENETRATION
+                fits = (
+                    p.max_gap <= cfg.max_placement_gap
+                    and p.penetration <= cfg.max_placement_penetration
+                )
                 rows.append((task.task_id, fits, float(np.max(p.grip_angles_deg))))
             results[(hand_name, reading)] = rows
             placed = [a for _, ok, a in rows if ok]

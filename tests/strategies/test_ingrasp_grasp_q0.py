@@ -61,7 +61,7 @@ def test_touch_configuration_balances_the_pd_drive(apple01):
     idx = joint_indices(p.fingers)
     lo, hi = hand.limits(FINGERS)
     q0 = p.q_rest
-    qc = touch_configuration(hand, q0, idx, p.fingers, 3.0, np.full(len(idx), KP), lo, hi)
+    qc = touch_configuration(hand, q0, p.fingers, 3.0, np.full(len(idx), KP), lo, hi)
     assert np.array_equal(np.delete(qc, idx), np.delete(q0, idx))  # unused fingers untouched
     tau = KP * (q0[idx] - qc[idx])
     forces = []
@@ -89,9 +89,10 @@ def test_command_mode_sets_a_round_grasp_inside_the_friction_cone(apple01):
         p, apple01.object, 1.0
     )
     hand = planner.hand
-    idx = joint_indices(p.fingers)
     lo, hi = hand.limits(FINGERS)
-    qc = touch_configuration(hand, p.q_rest, idx, p.fingers, 3.0, np.full(len(idx), KP), lo, hi)
+    qc = touch_configuration(
+        hand, p.q_rest, p.fingers, 3.0, np.full(4 * len(p.fingers), KP), lo, hi
+    )
     command = InGraspExecutor(hand, ExecConfig(grasp_q0="command")).placement(
         p, apple01.object, 1.0, qc
     )

@@ -248,7 +248,6 @@ def squeeze_offsets(
 def touch_configuration(
     hand: HandKinematics,
     q0: np.ndarray,
-    idx: np.ndarray,
     fingers: tuple[str, ...],
     force: float,
     stiffness: np.ndarray,
@@ -261,8 +260,9 @@ def touch_configuration(
     A joint PD drive of stiffness ``K`` commanded to ``q0`` holds a fingertip force ``f`` at
     ``q_c = q0 - K^-1 J(q_c)^T f(q_c)`` (the squeeze of :func:`squeeze_offsets`), solved by fixed
     point from ``q0`` (each step moves less than a milliradian after three); 16 joints in and out,
-    only ``idx`` (the used fingers') changed, kept inside ``lower``..``upper``.
+    only ``fingers``' joints changed (``stiffness`` is theirs), kept inside ``lower``..``upper``.
     """
+    idx = joint_indices(fingers)
     q = np.asarray(q0, float).copy()
     for _ in range(iterations):
         q[idx] = q0[idx] - squeeze_offsets(hand, q[idx], fingers, force, stiffness)
@@ -396,9 +396,7 @@ class InGraspExecutor:
         lo, hi = hand_grip.lower, hand_grip.upper
         q0 = problem.q_rest.copy()
         q_touch = (
-            touch_configuration(
-                self.hand, q0, idx, problem.fingers, cfg.squeeze_force, kp[idx], lo, hi
-            )
+            touch_configuration(self.hand, q0, problem.fingers, cfg.squeeze_force, kp[idx], lo, hi)
             if cfg.grasp_q0 == "command"
             else q0.copy()
         )
@@ -418,7 +416,6 @@ class InGraspExecutor:
         wall_place = time.perf_counter() - wall0
         model = load_object(object_name)
 
-        sq0 = squeeze_offsets(self.hand, q0[idx], problem.fingers, cfg.squeeze_force, kp[idx])
         back = backoff_offsets(self.hand, q_touch[idx], problem.fingers, cfg.preshape_open)
         q_pre = q_touch.copy()
         q_pre[idx] += back
@@ -546,7 +543,9 @@ class InGraspExecutor:
         # the set-up's closing target: q_0 plus the squeeze, or (grasp_q0 "command") q_0 itself
         q_closed = q0.copy()
         if cfg.grasp_q0 == "contact":
-            q_closed[idx] += sq0
+            q_closed[idx] += squeeze_offsets(
+                self.hand, q0[idx], problem.fingers, cfg.squeeze_force, kp[idx]
+            )
         phase = "setup"
         exec_sim = 0.0
         reached_m = None

@@ -64,7 +64,7 @@ def task_for_item(item) -> InGraspTask:
 class InGraspPlanner:
     """Plans (and, as a runner strategy, executes) Level I in-grasp trajectories on the Allegro.
 
-    The hand model is the trial robot's own description (``allegro`` or ``allegro-biotac``), built
+    The hand model is the trial robot's own description (its URDF, e.g. ``robots/allegro``), built
     once per process, unless ``urdf``/``hand`` fixes one; offline planning (:meth:`plan_task`) uses
     that or the stock Allegro. ``exec_config`` sets up the simulated trials (:class:`ExecConfig`).
     """
