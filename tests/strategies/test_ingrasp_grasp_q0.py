@@ -122,3 +122,34 @@ def test_command_mode_holds_the_apple(apple01, backend):
 def test_grasp_q0_is_validated():
     with pytest.raises(ValueError, match="grasp_q0 must be 'contact' or 'command', not 'measured'"):
         ExecConfig(grasp_q0="measured")  # type: ignore[arg-type]
+
+
+def test_grasp_q0_from_the_command_line(tmp_path):
+    """``--strategy-option exec_config.grasp_q0=...``: listed with its default, a wrong value refused
+    in one line (exit 2) before any trial and without creating the store."""
+    import json
+
+    from click.testing import CliRunner
+
+    from benchharness.cli.main import cli
+
+    r = CliRunner().invoke(cli, ["plugins", "--options", "relaxed-rigidity", "--json"])
+    assert r.exit_code == 0, r.output
+    keys = {o["key"]: o for o in json.loads(r.output)["options"]}
+    assert keys["exec_config.grasp_q0"]["default"] == "command"
+    store = tmp_path / "s.sqlite"
+    args = [
+        "run",
+        "--task",
+        "inhand-level1",
+        "--robot",
+        "allegro",
+        "--strategy",
+        "relaxed-rigidity",
+    ]
+    opt = ["--strategy-option", "exec_config.grasp_q0=measured", "--store", str(store)]
+    r = CliRunner().invoke(cli, [*args, "--backend", "pybullet", "--trials", "1", *opt])
+    assert r.exit_code == 2, r.output
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "exec_config.grasp_q0=measured" in lines[0], r.stderr
+    assert not store.exists()
