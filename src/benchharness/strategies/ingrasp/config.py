@@ -60,6 +60,18 @@ class IngraspConfig:
     w_limits: float = (
         1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
     )
+    #: hand-object collision, our extension (off by default): with a :class:`~.collision.CollisionScene`
+    #: (simulated trials), the squared shortfall (m^2) of each hand shape's distance to the object
+    #: below its allowed distance, per waypoint and shape. The Autonomous Robots 2019 method's
+    #: signed-distance cost keeps the object off its *environment*, of which a Level I task in
+    #: free space has none, so the published method plans without it. 1e6 weighs it as the
+    #: object-path variants' contact constraints. Measured effect: docs/ingrasp.md "Collision term"
+    w_collision: float = 0.0
+    #: m, the distance every hand shape other than the used fingertips keeps from the object (or
+    #: its distance at the initial grasp, if smaller): the set-up placement's clearance
+    collision_margin: float = 0.001
+    #: object surface samples the collision term uses (every n-th mesh vertex)
+    collision_points: int = 600
     #: ``"trf"``: bounded trust-region least squares on the residuals (scipy, exact Jacobian; the
     #: default); ``"lm"``: in-house Levenberg-Marquardt; ``"lbfgs"``: L-BFGS on the sum of squares
     #: (the default before 2026-12-02, which stopped short). docs/ingrasp.md "Solver"
@@ -92,6 +104,8 @@ class IngraspConfig:
             raise ValueError(f"solver must be 'trf', 'lm' or 'lbfgs', not {self.solver!r}")
         if self.init not in ("ik", "constant"):
             raise ValueError(f"init must be 'ik' or 'constant', not {self.init!r}")
+        if self.w_collision < 0 or self.collision_margin < 0 or self.collision_points < 1:
+            raise ValueError("w_collision, collision_margin must be >= 0, collision_points >= 1")
         if self.duration_s <= 0 or self.max_joint_speed <= 0:
             raise ValueError("duration_s and max_joint_speed must be positive")
 

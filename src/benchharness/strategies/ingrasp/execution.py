@@ -348,6 +348,42 @@ class InGraspExecutor:
             self.grip_cone_deg(friction),
         )
 
+    def nominal_setup(
+        self, backend, robot, problem: InGraspProblem, object_name: str
+    ) -> tuple[np.ndarray, InGraspPlacement, float]:
+        """Where the set-up puts the object before its noise: ``(q_touch, placement, friction)``.
+
+        ``q_touch`` (16,): the joints at which the fingertips touch (:attr:`ExecConfig.grasp_q0`);
+        the placement makes them touch there for the contact friction of ``backend``. The plan's
+        collision term reads the same answer. Raises :class:`SetupInfeasible` when no pose of the
+        object fits the grasp (see :meth:`run`).
+        """
+        cfg = self.config
+        hand_grip = robot.gripper("hand")
+        kp = np.asarray(hand_grip.config.stiffness, float)
+        idx = joint_indices(problem.fingers)
+        lo, hi = hand_grip.lower, hand_grip.upper
+        q0 = problem.q_rest.copy()
+        q_touch = (
+            touch_configuration(self.hand, q0, problem.fingers, cfg.squeeze_force, kp[idx], lo, hi)
+            if cfg.grasp_q0 == "command"
+            else q0.copy()
+        )
+        mu = self.contact_friction(backend)
+        place = self.placement(problem, object_name, mu, q_touch)
+        if place.max_gap > cfg.max_placement_gap:
+            raise SetupInfeasible(
+                f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
+                f"(best gap {place.max_gap * 1e3:.1f} mm)"
+            )
+        if place.penetration > cfg.max_placement_penetration:
+            raise SetupInfeasible(
+                f"{problem.task_id}: the published grasp does not fit our {object_name} model: at the "
+                f"best placement a hand part is {place.penetration * 1e3:.1f} mm inside it "
+                f"(max_placement_penetration {cfg.max_placement_penetration * 1e3:g} mm)"
+            )
+        return q_touch, place, mu
+
     # ----------------------------------------------------------------- the trial
     def run(
         self,
@@ -390,29 +426,12 @@ class InGraspExecutor:
                 f"description ({robot_urdf})"
             )
         wall0 = time.perf_counter()
+        q0 = problem.q_rest.copy()
+        q_touch, place, mu = self.nominal_setup(backend, robot, problem, object_name)
         hand_grip = robot.gripper("hand")
         kp = np.asarray(hand_grip.config.stiffness, float)
         idx = joint_indices(problem.fingers)
         lo, hi = hand_grip.lower, hand_grip.upper
-        q0 = problem.q_rest.copy()
-        q_touch = (
-            touch_configuration(self.hand, q0, problem.fingers, cfg.squeeze_force, kp[idx], lo, hi)
-            if cfg.grasp_q0 == "command"
-            else q0.copy()
-        )
-        mu = self.contact_friction(backend)
-        place = self.placement(problem, object_name, mu, q_touch)
-        if place.max_gap > cfg.max_placement_gap:
-            raise SetupInfeasible(
-                f"{problem.task_id}: no pose of our {object_name} model touches all fingertips "
-                f"(best gap {place.max_gap * 1e3:.1f} mm)"
-            )
-        if place.penetration > cfg.max_placement_penetration:
-            raise SetupInfeasible(
-                f"{problem.task_id}: the published grasp does not fit our {object_name} model: at the "
-                f"best placement a hand part is {place.penetration * 1e3:.1f} mm inside it "
-                f"(max_placement_penetration {cfg.max_placement_penetration * 1e3:g} mm)"
-            )
         wall_place = time.perf_counter() - wall0
         model = load_object(object_name)
 

@@ -117,6 +117,18 @@ class HandKinematics:
 
     def tip_poses(self, q: torch.Tensor, fingers: Sequence[str]) -> torch.Tensor:
         """Fingertip transforms in the palm frame: ``q`` (B, 4 k) -> (B, k, 4, 4), differentiable."""
+        return self._walk(q, fingers, links=False)
+
+    def link_poses(self, q: torch.Tensor, fingers: Sequence[str]) -> torch.Tensor:
+        """Every link of ``fingers`` in the palm frame: ``q`` (B, 4 k) -> (B, k, 5, 4, 4), differentiable.
+
+        Per finger the four links each revolute joint moves (the frame of joint ``i``'s child,
+        e.g. ``link_0`` ... ``link_3``) and the fingertip (as :meth:`tip_poses`); the planner's
+        collision term places the links' collision boxes with them.
+        """
+        return self._walk(q, fingers, links=True)
+
+    def _walk(self, q: torch.Tensor, fingers: Sequence[str], links: bool) -> torch.Tensor:
         k = len(fingers)
         q = q.reshape(-1, k, 4)
         key = tuple(fingers)
@@ -134,12 +146,19 @@ class HandKinematics:
         p = first[None, :, :3, 3].expand(q.shape[0], k, 3)
         s, c = torch.sin(q)[..., None, None], torch.cos(q)[..., None, None]
         rots = torch.eye(3, dtype=DTYPE) + s * kx + (1.0 - c) * kx2  # (B, k, 4, 3, 3) Rodrigues
+        frames = []
         for i in range(4):
             r = r @ rots[:, :, i]
+            if links:  # joint i's child link: the joint's origin, turned by the joint
+                frames.append((r, p))
             p = p + (r @ np_[None, :, i, :, None])[..., 0]
             r = r @ nr[None, :, i]
+        frames.append((r, p))
         bottom = torch.tensor([0.0, 0.0, 0.0, 1.0], dtype=DTYPE).expand(q.shape[0], k, 1, 4)
-        return torch.cat([torch.cat([r, p[..., None]], dim=-1), bottom], dim=-2)
+        out = [
+            torch.cat([torch.cat([ri, pi[..., None]], dim=-1), bottom], dim=-2) for ri, pi in frames
+        ]
+        return torch.stack(out, dim=2) if links else out[0]
 
     def tip_poses_pk(self, q: torch.Tensor, fingers: Sequence[str]) -> torch.Tensor:
         """As :meth:`tip_poses`, through pytorch-kinematics' generic chain walk (reference for tests)."""

@@ -11,9 +11,11 @@ from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 
+from .collision import CollisionScene, collision_scene
 from .config import VARIANTS, IngraspConfig
 from .execution import ExecConfig, InGraspExecutor, SetupInfeasible
 from .hand import HandKinematics, default_urdf
+from .placement import object_surface_arrays
 from .planner import PlanResult, plan, tip_rotation_deg
 from .problem import InGraspProblem, problem_from_task
 from .tasks import InGraspTask, published_tasks
@@ -100,8 +102,38 @@ class InGraspPlanner:
     def problem(self, task: InGraspTask, hand: HandKinematics | None = None) -> InGraspProblem:
         return problem_from_task(task, hand or self.hand, self.config.limit_margin)
 
-    def plan(self, problem: InGraspProblem, hand: HandKinematics | None = None) -> PlanResult:
-        return plan(hand or self.hand, problem, self.variant, self.config)
+    def plan(
+        self,
+        problem: InGraspProblem,
+        hand: HandKinematics | None = None,
+        scene: CollisionScene | None = None,
+    ) -> PlanResult:
+        return plan(hand or self.hand, problem, self.variant, self.config, scene)
+
+    def scene(
+        self,
+        hand: HandKinematics,
+        problem: InGraspProblem,
+        object_name: str,
+        body_in_palm,
+        q_touch=None,
+    ) -> CollisionScene | None:
+        """The collision scene of a simulated trial: our object model where the set-up puts it
+        (None when ``w_collision`` is 0)."""
+        if self.config.w_collision <= 0:
+            return None
+        from benchharness.objects import load_object
+
+        vertices = object_surface_arrays(load_object(object_name))[0]
+        return collision_scene(
+            hand,
+            problem,
+            vertices,
+            body_in_palm,
+            q_touch=q_touch,
+            margin=self.config.collision_margin,
+            max_points=self.config.collision_points,
+        )
 
     def plan_task(self, task: InGraspTask) -> PlanResult:
         return self.plan(self.problem(task))
@@ -117,7 +149,17 @@ class InGraspPlanner:
         task = task_for_item(ctx.item)
         hand = self.hand_for(ctx.robot)
         problem = self.problem(task, hand)
-        res = self.plan(problem, hand)
+        executor = InGraspExecutor(hand, self.exec_config)
+        # the plan keeps the hand off the object where the set-up will put it; a grasp that cannot
+        # be set up is still planned (without the object) so its row records the plan
+        infeasible: SetupInfeasible | None = None
+        scene = None
+        try:
+            q_touch, place, _ = executor.nominal_setup(ctx.backend, ctx.robot, problem, task.object)
+            scene = self.scene(hand, problem, task.object, place.pose, q_touch)
+        except SetupInfeasible as exc:
+            infeasible = exc
+        res = self.plan(problem, hand, scene)
         ctx.check_budget()
         ctx.recorder.event(
             "plan",
@@ -136,7 +178,15 @@ class InGraspPlanner:
                 tip_rotation_deg(hand, problem.fingers, res.q), 2
             ).tolist(),
         }
-        executor = InGraspExecutor(hand, self.exec_config)
+        if res.collision_shortfall is not None:
+            extra["plan_collision_shortfall_mm"] = round(res.collision_shortfall * 1e3, 4)
+        if infeasible is not None:
+            return TrialOutcome(
+                failure="unreachable",
+                message=f"set-up infeasible: {infeasible}",
+                plan_time_s=res.plan_time_s,
+                extra=extra,
+            )
         try:
             out = executor.run(
                 ctx.backend,
