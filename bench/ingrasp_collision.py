@@ -17,14 +17,12 @@ import argparse
 import time
 
 import numpy as np
-import torch
 
 
 def main() -> None:
     from benchharness.plugin import get_manager
     from benchharness.strategies.ingrasp import planner as P
     from benchharness.strategies.ingrasp.execution import InGraspExecutor, SetupInfeasible
-    from benchharness.strategies.ingrasp.hand import DTYPE
     from benchharness.strategies.ingrasp.strategy import InGraspPlanner
     from benchharness.strategies.ingrasp.tasks import published_tasks
 
@@ -58,18 +56,12 @@ def main() -> None:
             print(f"{t.task_id:32s} set-up infeasible")
             continue
         scene = pl.scene(hand, prob, t.object, place.pose, q_touch)
-        assert scene is not None and scene.allowed is not None
         cost = P._Cost(hand, prob, pl.variant, pl.config, scene)
         q_goal = P.rigid_goal_joints(hand, cost, pl.config)
         q0 = cost.q0.numpy()
         free = P._free_fraction(cost, q0, q_goal, pl.config)
         s = np.linspace(0.0, 1.0, 41)[1:]
-        path = torch.as_tensor(q0[None] + s[:, None] * (q_goal - q0)[None], dtype=DTYPE)
-        with torch.no_grad():
-            x_o = cost.object_poses(hand.tip_poses(path, prob.fingers))
-            short = (
-                scene.allowed[None] - scene.distances(scene.hand_links(hand, path), x_o)
-            ).clamp(min=0.0)
+        short = cost.collision_shortfalls(q0[None] + s[:, None] * (q_goal - q0)[None])
         worst = scene.names[int(short.max(0).values.argmax())] if float(short.max()) > 0 else "-"
         r0, r1 = pl.plan(prob, hand), pl.plan(prob, hand, scene)
         row = (

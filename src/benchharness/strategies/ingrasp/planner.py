@@ -278,12 +278,21 @@ class _Cost:
         """The most any hand shape comes nearer the object than allowed along ``q`` (T, 4 k), m."""
         if self.scene is None:
             return None
+        return float(self.collision_shortfalls(q).max())
+
+    def collision_shortfalls(
+        self, q: np.ndarray | torch.Tensor, object_poses: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        """How much nearer than allowed each hand shape comes to the object at each row of ``q``
+        (T, 4 k) -> (T, shapes), m, 0 where it keeps its distance; the object where the plan
+        carries it, or at ``object_poses`` (T, 4, 4). Needs a scene."""
+        assert self.scene is not None and self.scene.allowed is not None
         with torch.no_grad():
-            qt = torch.as_tensor(q, dtype=DTYPE)
-            x_o = self.object_poses(self.hand.tip_poses(qt, self.p.fingers))
-            d = self.scene.distances(self.scene.hand_links(self.hand, qt), x_o)
-            assert self.scene.allowed is not None
-            return float(torch.clamp(self.scene.allowed[None] - d, min=0.0).max())
+            qt = torch.as_tensor(np.asarray(q, float), dtype=DTYPE)
+            if object_poses is None:
+                object_poses = self.object_poses(self.hand.tip_poses(qt, self.p.fingers))
+            d = self.scene.distances(self.scene.hand_links(self.hand, qt), object_poses)
+            return torch.clamp(self.scene.allowed[None] - d, min=0.0)
 
 
 def _lbfgs(
@@ -483,17 +492,11 @@ def _free_fraction(cost: _Cost, q0: np.ndarray, q_goal: np.ndarray, cfg: Ingrasp
     deep in the hand (measured on apple-06: 10.8 mm, from a warm start 10.7 mm deep).
     """
     s = np.linspace(0.0, 1.0, 41)[1:]
-    path = torch.as_tensor(q0[None] + s[:, None] * (q_goal - q0)[None], dtype=DTYPE)
-    assert cost.scene is not None and cost.scene.allowed is not None
-    with torch.no_grad():
-        links = cost.scene.hand_links(cost.hand, path)
-        if cost.variant in RELAXED:
-            obj = cost.object_poses(cost.hand.tip_poses(path, cost.p.fingers))
-        else:  # the object-path variants carry the object along their own path, by waypoint
-            obj = torch.as_tensor(
-                interpolate_poses(cost.p.object_initial, cost.p.goal, s), dtype=DTYPE
-            )
-        short = (cost.scene.allowed[None] - cost.scene.distances(links, obj)).amax(-1)
+    path = q0[None] + s[:, None] * (q_goal - q0)[None]
+    obj = None  # relaxed variants: the object where the fingertips carry it
+    if cost.variant not in RELAXED:  # object-path variants: along their own path, by fraction
+        obj = torch.as_tensor(interpolate_poses(cost.p.object_initial, cost.p.goal, s), dtype=DTYPE)
+    short = cost.collision_shortfalls(path, obj).amax(-1)
     bad = np.flatnonzero(short.numpy() > 0.1 * cfg.collision_margin)
     return 1.0 if bad.size == 0 else float(s[bad[0]] - s[0])
 

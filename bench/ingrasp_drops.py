@@ -1,0 +1,137 @@
+"""Every drop of in-grasp Table II stores, per trial, with the measured signs of its cause (issue 14).
+
+Reads stores written by ``benchharness run --task inhand-level1`` (any methods, engines, repeats) and
+prints, per engine and method:
+
+* each drop (``task#repeat``) with: the phase it fell in (``execution``: during the plan, ``hold``: in the
+  5 s unsupported hold), the set-up placement's largest squeeze-to-normal angle beside the friction
+  cone's half angle (a grasp set outside its cone can only slip), the plan's largest fingertip turn
+  against the object (``plan_tip_rotation_deg``: turning a fingertip whose centre the plan holds on
+  the object means rolling it over the surface or sliding), and how deep the plan carries the object
+  into a hand part other than the used fingertips, and which (recomputed here: the trial's plan,
+  measured against our object model where the set-up put it, ``collision.collision_scene``; no
+  physics);
+* the median err_pos per object and method over the scored trials (the numbers behind Figure 7's
+  boxes), so a difference between two methods' medians can be traced to its objects.
+
+    python bench/ingrasp_drops.py --store t2-relaxed-rigidity-sapien.sqlite --store t2-point-contact-sapien.sqlite
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sqlite3
+from collections import defaultdict
+from functools import cache
+
+import numpy as np
+
+
+def read(paths: list[str]) -> list[dict]:
+    """One dict per trial of the stores: engine, method, outcome fields and the extras used here."""
+    rows = []
+    for path in paths:
+        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        for strategy, backend, status, oj in con.execute(
+            "select strategy, backend, status, outcome_json from trials order by trial_index"
+        ):
+            o = json.loads(oj or "{}")
+            e = o.get("extra") or {}
+            rows.append(
+                {
+                    "backend": backend,
+                    "strategy": strategy,
+                    "status": status,
+                    "task": o.get("task_id"),
+                    "object": o.get("object"),
+                    "repeat": o.get("repeat"),
+                    "dropped": bool(o.get("dropped")),
+                    "discarded": bool(o.get("discarded")),
+                    "err_pos": (o.get("metrics") or {}).get("err_pos"),
+                    "phase": e.get("phase"),
+                    "angle": max(e.get("placement_grip_angles_deg") or [float("nan")]),
+                    "cone": e.get("placement_grip_cone_deg"),
+                    "turn": max(e.get("plan_tip_rotation_deg") or [float("nan")]),
+                }
+            )
+        con.close()
+    return rows
+
+
+@cache
+def plan_depth(backend: str, strategy: str, task_id: str) -> tuple[float, str]:
+    """How deep (mm) the trial's plan carries our object into a hand part other than the used
+    fingertips, and which part ('-' if none comes nearer than at the initial grasp)."""
+    from benchharness.plugin import get_manager
+    from benchharness.strategies.ingrasp.execution import InGraspExecutor
+    from benchharness.strategies.ingrasp.planner import _Cost
+    from benchharness.strategies.ingrasp.strategy import InGraspPlanner, _published_by_id
+
+    task = _published_by_id()[task_id]
+    be = get_manager().create("backend", backend)
+    try:
+        robot = get_manager().create("robot", "allegro")
+        pl = InGraspPlanner(strategy)
+        hand = pl.hand_for(robot)
+        prob = pl.problem(task, hand)
+        q_touch, place, _ = InGraspExecutor(hand, pl.exec_config).nominal_setup(
+            be, robot, prob, task.object
+        )
+    finally:
+        be.close()
+    res = pl.plan(prob, hand)  # the trial's plan: the default planner has no collision term
+    # measure it against the object with a zero margin: depth below where each part starts
+    probe = InGraspPlanner(strategy, w_collision=1.0, collision_margin=0.0)
+    scene = probe.scene(hand, prob, task.object, place.pose, q_touch)
+    short = _Cost(hand, prob, strategy, probe.config, scene).collision_shortfalls(res.q[1:]).amax(0)
+    i = int(short.argmax())
+    return float(short[i]) * 1e3, scene.names[i] if float(short[i]) > 0 else "-"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--store", action="append", required=True, help="results store (repeatable)")
+    ap.add_argument(
+        "--no-depth", action="store_true", help="skip the plans' hand depth (no planning)"
+    )
+    args = ap.parse_args()
+    rows = read(args.store)
+    groups: dict[tuple[str, str], list[dict]] = defaultdict(list)
+    for r in rows:
+        groups[(r["backend"], r["strategy"])].append(r)
+    for (backend, strategy), rs in sorted(groups.items()):
+        scored = [r for r in rs if r["status"] == "success" or r["dropped"]]
+        scored = [r for r in scored if not r["discarded"]]
+        drops = [r for r in scored if r["dropped"]]
+        print(f"\n{backend} {strategy}: {len(drops)} drops of {len(scored)} scored trials")
+        if drops:
+            print(
+                f"  {'trial':34s} {'phase':>9s} {'angle/cone':>11s} {'turn':>6s} {'plan depth':>19s}"
+            )
+        for r in drops:
+            depth, part = (0.0, "") if args.no_depth else plan_depth(backend, strategy, r["task"])
+            cone = f"{r['cone']:.0f}" if r["cone"] is not None else "-"
+            print(
+                f"  {r['task'] + '#' + str(r['repeat']):34s} {str(r['phase']):>9s} "
+                f"{r['angle']:6.1f}/{cone:>4s} {r['turn']:6.1f} "
+                f"{'' if args.no_depth else f'{depth:6.2f} mm {part:>9s}':>19s}"
+            )
+    objects = sorted({r["object"] for r in rows if r["object"]})
+    keys = sorted(groups)
+    print("\nmedian err_pos (cm) per object over scored trials (n)")
+    print(f"  {'object':28s} " + " ".join(f"{b[:3] + ' ' + s[:20]:>26s}" for b, s in keys))
+    for obj in objects:
+        cells = []
+        for k in keys:
+            e = [
+                r["err_pos"] * 100
+                for r in groups[k]
+                if r["object"] == obj and r["status"] == "success" and r["err_pos"] is not None
+            ]
+            cells.append(f"{np.median(e):.2f} ({len(e)})" if e else "-")
+        print(f"  {obj:28s} " + " ".join(f"{c:>26s}" for c in cells))
+
+
+if __name__ == "__main__":
+    main()
