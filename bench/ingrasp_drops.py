@@ -12,9 +12,14 @@ prints, per engine and method:
   measured against our object model where the set-up put it, ``collision.collision_scene``; no
   physics);
 * the median err_pos per object and method over the scored trials (the numbers behind Figure 7's
-  boxes), so a difference between two methods' medians can be traced to its objects.
+  boxes), so a difference between two methods' medians can be traced to its objects;
+* with ``--compare A B``, per engine, the two methods' err_pos trial against trial (the same trial
+  index has the same task, repeat and set-up noise for every method): how often A ends nearer, the
+  median paired difference, a sign test, and a 95 % interval for the difference of the two
+  medians from resampling whole tasks (seeded: the same figures every run).
 
-    python bench/ingrasp_drops.py --store t2-relaxed-rigidity-sapien.sqlite --store t2-point-contact-sapien.sqlite
+    python bench/ingrasp_drops.py --store t2-relaxed-rigidity-sapien.sqlite --store t2-point-contact-sapien.sqlite \
+        --compare relaxed-rigidity point-contact
 """
 
 from __future__ import annotations
@@ -33,13 +38,15 @@ def read(paths: list[str]) -> list[dict]:
     rows = []
     for path in paths:
         con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        for strategy, backend, status, oj in con.execute(
-            "select strategy, backend, status, outcome_json from trials order by trial_index"
+        for index, strategy, backend, status, oj in con.execute(
+            "select trial_index, strategy, backend, status, outcome_json from trials"
+            " order by trial_index"
         ):
             o = json.loads(oj or "{}")
             e = o.get("extra") or {}
             rows.append(
                 {
+                    "index": index,
                     "backend": backend,
                     "strategy": strategy,
                     "status": status,
@@ -89,11 +96,59 @@ def plan_depth(backend: str, strategy: str, task_id: str) -> tuple[float, str]:
     return float(short[i]) * 1e3, scene.names[i] if float(short[i]) > 0 else "-"
 
 
+def compare(rows: list[dict], a: str, b: str, resamples: int = 2000) -> None:
+    """Method ``a`` against ``b`` on err_pos, trial against trial, per engine (module docstring)."""
+    from scipy.stats import binomtest
+
+    def scored(backend: str, strategy: str) -> dict[int, tuple[str, float]]:
+        return {
+            r["index"]: (r["task"], r["err_pos"] * 100)
+            for r in rows
+            if r["backend"] == backend
+            and r["strategy"] == strategy
+            and r["status"] == "success"
+            and not r["discarded"]
+            and r["err_pos"] is not None
+        }
+
+    for backend in sorted({r["backend"] for r in rows}):
+        ea, eb = scored(backend, a), scored(backend, b)
+        both = sorted(set(ea) & set(eb))
+        if not both:
+            continue
+        d = np.array([ea[i][1] - eb[i][1] for i in both])
+        nearer, farther = int((d < 0).sum()), int((d > 0).sum())
+        p = binomtest(nearer, nearer + farther).pvalue if nearer + farther else 1.0
+        by_task: dict[str, list[int]] = defaultdict(list)
+        for i in both:
+            by_task[ea[i][0]].append(i)
+        tasks = sorted(by_task)
+        rng = np.random.default_rng(0)
+        diffs = []
+        for _ in range(resamples):
+            ids = [i for k in rng.integers(0, len(tasks), len(tasks)) for i in by_task[tasks[k]]]
+            diffs.append(np.median([ea[i][1] for i in ids]) - np.median([eb[i][1] for i in ids]))
+        lo, hi = np.percentile(diffs, [2.5, 97.5])
+        med_a, med_b = (
+            np.median([v[1] for v in ea.values()]),
+            np.median([v[1] for v in eb.values()]),
+        )
+        print(
+            f"\n{backend}: {a} vs {b}, err_pos over {len(both)} trials scored for both: "
+            f"{a} nearer in {nearer}, farther in {farther} (sign test p = {p:.2g}); median paired "
+            f"difference {np.median(d):+.3f} cm; medians {med_a:.3f} / {med_b:.3f} cm (all scored), "
+            f"difference 95 % interval over resampled tasks [{lo:+.3f}, {hi:+.3f}] cm"
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--store", action="append", required=True, help="results store (repeatable)")
     ap.add_argument(
         "--no-depth", action="store_true", help="skip the plans' hand depth (no planning)"
+    )
+    ap.add_argument(
+        "--compare", nargs=2, metavar=("A", "B"), help="two methods, trial against trial"
     )
     args = ap.parse_args()
     rows = read(args.store)
@@ -131,6 +186,8 @@ def main() -> None:
             ]
             cells.append(f"{np.median(e):.2f} ({len(e)})" if e else "-")
         print(f"  {obj:28s} " + " ".join(f"{c:>26s}" for c in cells))
+    if args.compare:
+        compare(rows, *args.compare)
 
 
 if __name__ == "__main__":
