@@ -149,3 +149,16 @@ def test_a_trial_plans_around_the_hand_when_asked(hand):
     assert extras[1]["plan_collision_shortfall_mm"] < 0.2
     # held back from the goal it could only reach through the hand (test above: 10.8 mm deep)
     assert extras[1]["plan_pos_error_cm"] > 1.0 > extras[0]["plan_pos_error_cm"]
+
+
+@pytest.mark.parametrize(
+    "field, value, message",
+    [
+        ("w_collision", -1.0, "w_collision must be >= 0, not -1.0"),
+        ("collision_margin", -0.001, "collision_margin must be >= 0, not -0.001"),
+        ("collision_points", 0, "collision_points must be >= 1, not 0"),
+    ],
+)
+def test_collision_settings_are_validated(field, value, message):
+    with pytest.raises(ValueError, match=message):
+        IngraspConfig(**{field: value})

@@ -60,9 +60,9 @@ class IngraspConfig:
     w_limits: float = (
         1.0e5  #: squared violation of joint and step limits (rad^2), before the final projection
     )
-    #: hand-object collision, our extension (off by default): with a :class:`~.collision.CollisionScene`
-    #: (simulated trials), the squared shortfall (m^2) of each hand shape's distance to the object
-    #: below its allowed distance, per waypoint and shape. The Autonomous Robots 2019 method's
+    #: hand-object collision, our extension (0 = off, the default): in simulated trials, the squared
+    #: shortfall (m^2) of each hand part's distance to the object below its allowed distance, per
+    #: waypoint and part (strategies/ingrasp/collision.py). The Autonomous Robots 2019 method's
     #: signed-distance cost keeps the object off its *environment*, of which a Level I task in
     #: free space has none, so the published method plans without it. 1e6 weighs it as the
     #: object-path variants' contact constraints. Measured effect: docs/ingrasp.md "Collision term"
@@ -104,8 +104,11 @@ class IngraspConfig:
             raise ValueError(f"solver must be 'trf', 'lm' or 'lbfgs', not {self.solver!r}")
         if self.init not in ("ik", "constant"):
             raise ValueError(f"init must be 'ik' or 'constant', not {self.init!r}")
-        if self.w_collision < 0 or self.collision_margin < 0 or self.collision_points < 1:
-            raise ValueError("w_collision, collision_margin must be >= 0, collision_points >= 1")
+        for name in ("w_collision", "collision_margin"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name} must be >= 0, not {getattr(self, name)!r}")
+        if self.collision_points < 1:
+            raise ValueError(f"collision_points must be >= 1, not {self.collision_points!r}")
         if self.duration_s <= 0 or self.max_joint_speed <= 0:
             raise ValueError("duration_s and max_joint_speed must be positive")
 
