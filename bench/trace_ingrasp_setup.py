@@ -7,6 +7,7 @@ force of each used fingertip's contacts, the force on other hand links, and the 
 along the palm normal. Prints one line every ``--every`` seconds and the drop message.
 
     python bench/trace_ingrasp_setup.py --backend sapien --trial 16 [--until-s 1.5]
+    python bench/trace_ingrasp_setup.py --trial 74 --others --strategy-option w_collision=1e6
 """
 
 from __future__ import annotations
@@ -46,10 +47,21 @@ def main() -> None:
     ap.add_argument(
         "--exec-config", default="", help="ExecConfig overrides, k=v,k=v (floats, none, friction)"
     )
+    ap.add_argument(
+        "--strategy-option",
+        action="append",
+        default=[],
+        metavar="K=V",
+        help="a planner option as `benchharness run --strategy-option` takes it (repeatable)",
+    )
     args = ap.parse_args()
 
     spec = RunSpec(
-        task="inhand-level1", robot="allegro", strategy=args.strategy, backend=args.backend
+        task="inhand-level1",
+        robot="allegro",
+        strategy=args.strategy,
+        backend=args.backend,
+        strategy_options=tuple(tuple(o.split("=", 1)) for o in args.strategy_option),
     )
     rows: list[str] = []
     st: dict = {"obj": None, "phase": "close", "next": 0.0, "c0": None}
