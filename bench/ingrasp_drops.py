@@ -20,6 +20,10 @@ prints, per engine and method:
 
     python bench/ingrasp_drops.py --store t2-relaxed-rigidity-sapien.sqlite --store t2-point-contact-sapien.sqlite \
         --compare relaxed-rigidity point-contact
+    python bench/ingrasp_drops.py --plan-depth apple-04,apple-06 --methods relaxed-rigidity,point-contact
+
+``--plan-depth`` prints, for the given tasks, methods and engine (``--backend``), how deep each
+method's plan carries the object into the hand (no store needed, no physics).
 """
 
 from __future__ import annotations
@@ -143,7 +147,10 @@ def compare(rows: list[dict], a: str, b: str, resamples: int = 2000) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--store", action="append", required=True, help="results store (repeatable)")
+    ap.add_argument("--store", action="append", default=[], help="results store (repeatable)")
+    ap.add_argument("--plan-depth", default="", help="comma-separated task ids: plan depth only")
+    ap.add_argument("--methods", default="relaxed-rigidity,point-contact", help="for --plan-depth")
+    ap.add_argument("--backend", default="pybullet", help="for --plan-depth: whose friction")
     ap.add_argument(
         "--no-depth", action="store_true", help="skip the plans' hand depth (no planning)"
     )
@@ -151,6 +158,17 @@ def main() -> None:
         "--compare", nargs=2, metavar=("A", "B"), help="two methods, trial against trial"
     )
     args = ap.parse_args()
+    if args.plan_depth:
+        methods = args.methods.split(",")
+        print(f"{'task':32s} " + " ".join(f"{m:>30s}" for m in methods))
+        for task in args.plan_depth.split(","):
+            cells = [plan_depth(args.backend, m, task) for m in methods]
+            print(
+                f"{task:32s} " + " ".join(f"{d:8.2f} mm {part:>9s}".rjust(30) for d, part in cells)
+            )
+        return
+    if not args.store:
+        ap.error("give --store (or --plan-depth)")
     rows = read(args.store)
     groups: dict[tuple[str, str], list[dict]] = defaultdict(list)
     for r in rows:
