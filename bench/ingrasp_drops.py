@@ -64,6 +64,7 @@ def read(paths: list[str]) -> list[dict]:
                     "angle": max(e.get("placement_grip_angles_deg") or [float("nan")]),
                     "cone": e.get("placement_grip_cone_deg"),
                     "turn": max(e.get("plan_tip_rotation_deg") or [float("nan")]),
+                    "plan_err": e.get("plan_pos_error_cm"),
                 }
             )
         con.close()
@@ -104,9 +105,9 @@ def compare(rows: list[dict], a: str, b: str, resamples: int = 2000) -> None:
     """Method ``a`` against ``b`` on err_pos, trial against trial, per engine (module docstring)."""
     from scipy.stats import binomtest
 
-    def scored(backend: str, strategy: str) -> dict[int, tuple[str, float]]:
+    def scored(backend: str, strategy: str) -> dict[int, tuple[str, float, float]]:
         return {
-            r["index"]: (r["task"], r["err_pos"] * 100)
+            r["index"]: (r["task"], r["err_pos"] * 100, r["plan_err"])
             for r in rows
             if r["backend"] == backend
             and r["strategy"] == strategy
@@ -143,6 +144,21 @@ def compare(rows: list[dict], a: str, b: str, resamples: int = 2000) -> None:
             f"difference {np.median(d):+.3f} cm; medians {med_a:.3f} / {med_b:.3f} cm (all scored), "
             f"difference 95 % interval over resampled tasks [{lo:+.3f}, {hi:+.3f}] cm"
         )
+        # the same, split by how the two plans end against the goal (planned error, 0.01 cm apart)
+        groups = {"plans within 0.01 cm": [], f"{a}'s plan farther": [], f"{a}'s plan nearer": []}
+        names = list(groups)
+        for i in both:
+            gap = ea[i][2] - eb[i][2]
+            groups[names[0] if abs(gap) <= 0.01 else names[1] if gap > 0 else names[2]].append(i)
+        for name, ids in groups.items():
+            dd = np.array([ea[i][1] - eb[i][1] for i in ids])
+            n1, n2 = int((dd < 0).sum()), int((dd > 0).sum())
+            pp = binomtest(n1, n1 + n2).pvalue if n1 + n2 else 1.0
+            med = f"{np.median(dd):+.3f}" if len(dd) else "-"
+            print(
+                f"  {name:36s} {len(ids):4d} trials: {a} nearer {n1}, farther {n2} "
+                f"(p = {pp:.2g}), median difference {med} cm"
+            )
 
 
 def main() -> None:
