@@ -20,10 +20,11 @@ prints, per engine and method:
 
     python bench/ingrasp_drops.py --store t2-relaxed-rigidity-sapien.sqlite --store t2-point-contact-sapien.sqlite \
         --compare relaxed-rigidity point-contact
-    python bench/ingrasp_drops.py --plan-depth apple-04,apple-06 --methods relaxed-rigidity,point-contact
+    python bench/ingrasp_drops.py --plans apple-04,apple-06 --methods relaxed-rigidity,point-contact
 
-``--plan-depth`` prints, for the given tasks, methods and engine (``--backend``), how deep each
-method's plan carries the object into the hand (no store needed, no physics).
+``--plans`` prints, for the given tasks, methods and engine (``--backend``), each method's plan
+measured (no store needed, no physics): how deep it carries the object into the hand, its planned
+error against the goal, and how far its fingertips end from the rigidly carried grasp.
 """
 
 from __future__ import annotations
@@ -72,9 +73,13 @@ def read(paths: list[str]) -> list[dict]:
 
 
 @cache
-def plan_depth(backend: str, strategy: str, task_id: str) -> tuple[float, str]:
-    """How deep (mm) the trial's plan carries our object into a hand part other than the used
-    fingertips, and which part ('-' if none comes nearer than at the initial grasp)."""
+def plan_facts(backend: str, strategy: str, task_id: str) -> tuple[float, str, float, float, float]:
+    """The trial's plan, measured: how deep (mm) it carries our object into a hand part other than
+    the used fingertips and which part ('-' if none comes nearer than at the initial grasp); its
+    object's error against the goal (cm, deg); how far (mm) its last fingertips stand from where the
+    initial grasp, carried rigidly to the goal, would put them (0: the grasp kept rigid)."""
+    import numpy as np
+
     from benchharness.plugin import get_manager
     from benchharness.strategies.ingrasp.execution import InGraspExecutor
     from benchharness.strategies.ingrasp.planner import _Cost
@@ -96,9 +101,19 @@ def plan_depth(backend: str, strategy: str, task_id: str) -> tuple[float, str]:
     # measure it against the object with a zero margin: depth below where each part starts
     probe = InGraspPlanner(strategy, w_collision=1.0, collision_margin=0.0)
     scene = probe.scene(hand, prob, task.object, place.pose, q_touch)
-    short = _Cost(hand, prob, strategy, probe.config, scene).collision_shortfalls(res.q[1:]).amax(0)
+    cost = _Cost(hand, prob, strategy, probe.config, scene)
+    short = cost.collision_shortfalls(res.q[1:]).amax(0)
     i = int(short.argmax())
-    return float(short[i]) * 1e3, scene.names[i] if float(short[i]) > 0 else "-"
+    rigid = (cost.goal[None] @ cost.tip_in_obj)[:, :3, 3].numpy()
+    tips = hand.tip_poses_np(res.q[-1][None], prob.fingers)[0][:, :3, 3]
+    off = float(np.linalg.norm(tips - rigid, axis=1).max()) * 1e3
+    return (
+        float(short[i]) * 1e3,
+        scene.names[i] if float(short[i]) > 0 else "-",
+        res.pos_error * 100,
+        float(np.degrees(res.rot_error)),
+        off,
+    )
 
 
 def compare(rows: list[dict], a: str, b: str, resamples: int = 2000) -> None:
@@ -164,9 +179,9 @@ def compare(rows: list[dict], a: str, b: str, resamples: int = 2000) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--store", action="append", default=[], help="results store (repeatable)")
-    ap.add_argument("--plan-depth", default="", help="comma-separated task ids: plan depth only")
-    ap.add_argument("--methods", default="relaxed-rigidity,point-contact", help="for --plan-depth")
-    ap.add_argument("--backend", default="pybullet", help="for --plan-depth: whose friction")
+    ap.add_argument("--plans", default="", help="comma-separated task ids: their plans only")
+    ap.add_argument("--methods", default="relaxed-rigidity,point-contact", help="for --plans")
+    ap.add_argument("--backend", default="pybullet", help="for --plans: whose friction")
     ap.add_argument(
         "--no-depth", action="store_true", help="skip the plans' hand depth (no planning)"
     )
@@ -174,17 +189,20 @@ def main() -> None:
         "--compare", nargs=2, metavar=("A", "B"), help="two methods, trial against trial"
     )
     args = ap.parse_args()
-    if args.plan_depth:
-        methods = args.methods.split(",")
-        print(f"{'task':32s} " + " ".join(f"{m:>30s}" for m in methods))
-        for task in args.plan_depth.split(","):
-            cells = [plan_depth(args.backend, m, task) for m in methods]
-            print(
-                f"{task:32s} " + " ".join(f"{d:8.2f} mm {part:>9s}".rjust(30) for d, part in cells)
-            )
+    if args.plans:
+        print(
+            "per method: planned error cm / deg, fingertips off the rigid grasp mm, depth mm part"
+        )
+        for task in args.plans.split(","):
+            for m in args.methods.split(","):
+                d, part, e_cm, e_deg, off = plan_facts(args.backend, m, task)
+                print(
+                    f"  {task:30s} {m:30s} {e_cm:6.3f} cm {e_deg:6.2f} deg {off:6.2f} mm "
+                    f"{d:6.2f} mm {part}"
+                )
         return
     if not args.store:
-        ap.error("give --store (or --plan-depth)")
+        ap.error("give --store (or --plans)")
     rows = read(args.store)
     groups: dict[tuple[str, str], list[dict]] = defaultdict(list)
     for r in rows:
@@ -199,7 +217,9 @@ def main() -> None:
                 f"  {'trial':34s} {'phase':>9s} {'angle/cone':>11s} {'turn':>6s} {'plan depth':>19s}"
             )
         for r in drops:
-            depth, part = (0.0, "") if args.no_depth else plan_depth(backend, strategy, r["task"])
+            depth, part = (
+                (0.0, "") if args.no_depth else plan_facts(backend, strategy, r["task"])[:2]
+            )
             cone = f"{r['cone']:.0f}" if r["cone"] is not None else "-"
             print(
                 f"  {r['task'] + '#' + str(r['repeat']):34s} {str(r['phase']):>9s} "
