@@ -16,7 +16,8 @@ prints, per engine and method:
 * with ``--compare A B``, per engine, the two methods' err_pos trial against trial (the same trial
   index has the same task, repeat and set-up noise for every method): how often A ends nearer, the
   median paired difference, a sign test, and a 95 % interval for the difference of the two
-  medians from resampling whole tasks (seeded: the same figures every run).
+  medians from resampling whole tasks (seeded: the same figures every run); then the same counts
+  split by how the two plans end against the goal (within 0.01 cm of each other, or one farther).
 
     python bench/ingrasp_drops.py --store t2-relaxed-rigidity-sapien.sqlite --store t2-point-contact-sapien.sqlite \
         --compare relaxed-rigidity point-contact
