@@ -40,23 +40,13 @@ from benchharness.strategies.ingrasp.problem import clamp_grasp
 from benchharness.strategies.ingrasp.tasks import distinct_initial_grasps
 
 V4, BT = descriptions.V4, descriptions.LL4MA_BIOTAC
+#: the LL4MA description's figures that make its thumb, and those that make its BioTac fingertips
+THUMB_FIELDS = ("limits", "thumb_limits", "thumb_xyz", "thumb_rpy")
+TIP_FIELDS = ("tip_centre", "thumb_tip_centre", "tip_r", "distal_box", "thumb_distal_box")
 HANDS = {
     "v4": V4,
-    "v4 + LL4MA thumb": dataclasses.replace(
-        V4,
-        limits=BT.limits,
-        thumb_limits=BT.thumb_limits,
-        thumb_xyz=BT.thumb_xyz,
-        thumb_rpy=BT.thumb_rpy,
-    ),
-    "BioTac tips": dataclasses.replace(
-        V4,
-        tip_centre=BT.tip_centre,
-        thumb_tip_centre=BT.thumb_tip_centre,
-        tip_r=BT.tip_r,
-        distal_box=BT.distal_box,
-        thumb_distal_box=BT.thumb_distal_box,
-    ),
+    "v4 + LL4MA thumb": dataclasses.replace(V4, **{f: getattr(BT, f) for f in THUMB_FIELDS}),
+    "BioTac tips": dataclasses.replace(V4, **{f: getattr(BT, f) for f in TIP_FIELDS}),
     "LL4MA BioTac": BT,
 }
 CASES = [(h, "contact") for h in HANDS] + [("v4", "command")]

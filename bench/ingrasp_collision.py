@@ -22,7 +22,7 @@ import numpy as np
 def main() -> None:
     from benchharness.plugin import get_manager
     from benchharness.strategies.ingrasp import planner as P
-    from benchharness.strategies.ingrasp.execution import InGraspExecutor, SetupInfeasible
+    from benchharness.strategies.ingrasp.execution import SetupInfeasible
     from benchharness.strategies.ingrasp.strategy import InGraspPlanner
     from benchharness.strategies.ingrasp.tasks import published_tasks
 
@@ -41,7 +41,6 @@ def main() -> None:
     robot = get_manager().create("robot", "allegro")
     pl = InGraspPlanner(args.variant, w_collision=args.w_collision)
     hand = pl.hand_for(robot)
-    exe = InGraspExecutor(hand, pl.exec_config)
     rows = []
     wall0, cpu0 = time.perf_counter(), time.process_time()
     print(
@@ -51,11 +50,10 @@ def main() -> None:
     for t in tasks:
         prob = pl.problem(t, hand)
         try:
-            q_touch, place, _ = exe.nominal_setup(be, robot, prob, t.object)
+            scene = pl.trial_scene(be, robot, prob, t.object, hand)
         except SetupInfeasible:
             print(f"{t.task_id:32s} set-up infeasible")
             continue
-        scene = pl.scene(hand, prob, t.object, place.pose, q_touch)
         cost = P._Cost(hand, prob, pl.variant, pl.config, scene)
         q_goal = P.rigid_goal_joints(hand, cost, pl.config)
         q0 = cost.q0.numpy()

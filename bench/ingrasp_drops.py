@@ -82,26 +82,22 @@ def plan_facts(backend: str, strategy: str, task_id: str) -> tuple[float, str, f
     import numpy as np
 
     from benchharness.plugin import get_manager
-    from benchharness.strategies.ingrasp.execution import InGraspExecutor
     from benchharness.strategies.ingrasp.planner import _Cost
     from benchharness.strategies.ingrasp.strategy import InGraspPlanner, _published_by_id
 
     task = _published_by_id()[task_id]
+    pl = InGraspPlanner(strategy)
+    # measured against the object with a zero margin: depth below where each part starts
+    probe = InGraspPlanner(strategy, w_collision=1.0, collision_margin=0.0)
     be = get_manager().create("backend", backend)
     try:
         robot = get_manager().create("robot", "allegro")
-        pl = InGraspPlanner(strategy)
         hand = pl.hand_for(robot)
         prob = pl.problem(task, hand)
-        q_touch, place, _ = InGraspExecutor(hand, pl.exec_config).nominal_setup(
-            be, robot, prob, task.object
-        )
+        scene = probe.trial_scene(be, robot, prob, task.object, hand)
     finally:
         be.close()
     res = pl.plan(prob, hand)  # the trial's plan: the default planner has no collision term
-    # measure it against the object with a zero margin: depth below where each part starts
-    probe = InGraspPlanner(strategy, w_collision=1.0, collision_margin=0.0)
-    scene = probe.scene(hand, prob, task.object, place.pose, q_touch)
     cost = _Cost(hand, prob, strategy, probe.config, scene)
     short = cost.collision_shortfalls(res.q[1:]).amax(0)
     i = int(short.argmax())

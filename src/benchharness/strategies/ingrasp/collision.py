@@ -176,7 +176,6 @@ def collision_scene(
         for i, f in enumerate(problem.fingers)
         for j, name in enumerate(_finger_links(f))
     }
-    tips_used = {TIP_LINKS[f] for f in problem.fingers}
     t = lambda a: torch.as_tensor(np.asarray(a, float), dtype=DTYPE)  # noqa: E731
     idx, in_link, half, names = [], [], [], []
     s_inv, s_half, s_names = [], [], []
@@ -193,7 +192,7 @@ def collision_scene(
                 s_names.append(link)
     c_pos, c_rad, c_names = [], [], []
     for link, balls in sorted(geo.spheres.items()):
-        if link in tips_used or link in used_links or link not in frames:
+        if link in used_links or link not in frames:  # the used fingertips are the contacts
             continue
         for c, r in balls:
             c_pos.append((frames[link] @ np.append(c, 1.0))[:3])

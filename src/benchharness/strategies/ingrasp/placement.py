@@ -150,7 +150,6 @@ def place_object(
     clearance: float = 0.001,
     w_rot: float = 0.003,
     w_com: float = 0.02,
-    urdf: str | None = None,
     max_vertices: int = 400,
     refine: int = 4,
     grip_cone_deg: float | None = None,
@@ -178,7 +177,7 @@ def place_object(
     the squeeze only slides along, and the grip ejects the object as soon as
     it is released (docs/ingrasp.md, "Set-up drops").
     """
-    geo = hand_geometry(urdf or hand.urdf_path)
+    geo = hand_geometry(hand.urdf_path)  # the collision shapes of the same description
     frames = link_frames(hand, q16)
     tips_used = {TIP_LINKS[f] for f in fingers}
     tip_c, tip_r = [], []

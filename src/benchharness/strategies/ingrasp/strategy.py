@@ -110,26 +110,25 @@ class InGraspPlanner:
     ) -> PlanResult:
         return plan(hand or self.hand, problem, self.variant, self.config, scene)
 
-    def scene(
-        self,
-        hand: HandKinematics,
-        problem: InGraspProblem,
-        object_name: str,
-        body_in_palm,
-        q_touch=None,
+    def trial_scene(
+        self, backend, robot, problem: InGraspProblem, object_name: str, hand=None
     ) -> CollisionScene | None:
-        """The collision scene of a simulated trial: our object model where the set-up puts it
-        (None when ``w_collision`` is 0)."""
+        """The collision scene of a simulated trial: our object model where its set-up puts it in
+        ``backend`` (:meth:`InGraspExecutor.nominal_setup`); None when ``w_collision`` is 0.
+        Raises :class:`SetupInfeasible` when no placement fits the grasp."""
         if self.config.w_collision <= 0:
             return None
         from benchharness.objects import load_object
 
-        vertices = object_surface_arrays(load_object(object_name))[0]
+        hand = hand or self.hand_for(robot)
+        q_touch, place, _ = InGraspExecutor(hand, self.exec_config).nominal_setup(
+            backend, robot, problem, object_name
+        )
         return collision_scene(
             hand,
             problem,
-            vertices,
-            body_in_palm,
+            object_surface_arrays(load_object(object_name))[0],
+            place.pose,
             q_touch=q_touch,
             margin=self.config.collision_margin,
             max_points=self.config.collision_points,
@@ -149,16 +148,10 @@ class InGraspPlanner:
         task = task_for_item(ctx.item)
         hand = self.hand_for(ctx.robot)
         problem = self.problem(task, hand)
-        executor = InGraspExecutor(hand, self.exec_config)
-        # the plan keeps the hand off the object where the set-up will put it; a grasp that cannot
-        # be set up is still planned (without the object) so its row records the plan
-        infeasible: SetupInfeasible | None = None
-        scene = None
-        try:
-            q_touch, place, _ = executor.nominal_setup(ctx.backend, ctx.robot, problem, task.object)
-            scene = self.scene(hand, problem, task.object, place.pose, q_touch)
-        except SetupInfeasible as exc:
-            infeasible = exc
+        try:  # the plan keeps the hand off the object where the set-up will put it
+            scene = self.trial_scene(ctx.backend, ctx.robot, problem, task.object, hand)
+        except SetupInfeasible:  # planned without the object; run() below refuses the set-up
+            scene = None
         res = self.plan(problem, hand, scene)
         ctx.check_budget()
         ctx.recorder.event(
@@ -180,13 +173,7 @@ class InGraspPlanner:
         }
         if res.collision_shortfall is not None:
             extra["plan_collision_shortfall_mm"] = round(res.collision_shortfall * 1e3, 4)
-        if infeasible is not None:
-            return TrialOutcome(
-                failure="unreachable",
-                message=f"set-up infeasible: {infeasible}",
-                plan_time_s=res.plan_time_s,
-                extra=extra,
-            )
+        executor = InGraspExecutor(hand, self.exec_config)
         try:
             out = executor.run(
                 ctx.backend,
