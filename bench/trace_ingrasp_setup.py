@@ -8,6 +8,7 @@ along the palm normal. Prints one line every ``--every`` seconds and the drop me
 
     python bench/trace_ingrasp_setup.py --backend sapien --trial 16 [--until-s 1.5]
     python bench/trace_ingrasp_setup.py --trial 74 --others --strategy-option w_collision=1e6
+    python bench/trace_ingrasp_setup.py --backend sapien --trial 431 --repeats 5   # lego_duplo-01, 5th
 """
 
 from __future__ import annotations
@@ -28,6 +29,12 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--backend", default="pybullet")
     ap.add_argument("--trial", type=int, required=True)
+    ap.add_argument(
+        "--repeats",
+        type=int,
+        default=1,
+        help="as `benchharness run --repeats`: trial t + (r-1)*100 is repeat r of row t (docs/inhand.md)",
+    )
     ap.add_argument("--strategy", default="relaxed-rigidity")
     ap.add_argument("--every", type=float, default=0.05)
     ap.add_argument("--until-s", type=float, default=1.2, help="stop tracing after this sim time")
@@ -61,6 +68,7 @@ def main() -> None:
         robot="allegro",
         strategy=args.strategy,
         backend=args.backend,
+        repeats=args.repeats,
         strategy_options=tuple(tuple(o.split("=", 1)) for o in args.strategy_option),
     )
     rows: list[str] = []
