@@ -4,7 +4,7 @@ Builds each object's graph (DMG time), plans the task (Plan time), writes the
 results file (``write_results`` format, meshes beside it), scores it through
 the metric module and prints a Markdown table next to the published figures.
 
-    .venv/bin/python bench/bench_dmg.py [--out DIR] [--repeat N]
+    .venv/bin/python bench/bench_dmg.py [--out DIR] [--repeat N] [--model generated|ycb]
 
 ``--repeat`` times the graph construction and the query N times and reports
 the median (the planner is deterministic, so the plans are identical).
@@ -38,6 +38,7 @@ PUBLISHED = {
 def main(argv=None) -> int:
     from benchharness.inhand.fileformat import read_results, read_tasks, write_results
     from benchharness.inhand.scoring import score_results
+    from benchharness.strategies.dmg.config import DMGSurface
     from benchharness.strategies.dmg.strategy import (
         DESIRED_REGION_RADIUS,
         FINGER_PAD_RADIUS,
@@ -54,6 +55,12 @@ def main(argv=None) -> int:
         "--out", default="/tmp/benchharness-dmg", help="folder for results.csv and meshes/"
     )
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument(
+        "--model",
+        choices=("generated", "ycb"),
+        default="generated",
+        help="object model planned on and scored (DMGSurface.model; ycb: the vendored scans)",
+    )
     args = ap.parse_args(argv)
 
     tasks = read_tasks(args.tasks)
@@ -61,7 +68,7 @@ def main(argv=None) -> int:
     plan_times: dict[str, list[float]] = {}
     plans = None
     for _ in range(max(1, args.repeat)):
-        planner = DMGPlanner()
+        planner = DMGPlanner(surface=DMGSurface(model=args.model))
         plans = planner.plan_tasks(tasks)
         for p in plans:
             graph_times.setdefault(p.task_id, []).append(p.graph_time_s)

@@ -90,6 +90,16 @@ def write_region_tasks(path: str | Path) -> Path:
     return path
 
 
+def planner_for_outcome(outcome: dict[str, Any]):
+    """A DMG planner on the object model a stored trial ran on (``extra.dmg_surface``; before that
+    field existed every DMG trial ran on the generated model)."""
+    from ..strategies.dmg.config import DMGSurface
+    from ..strategies.dmg.strategy import DMGPlanner
+
+    model = (outcome.get("extra") or {}).get("dmg_surface", "generated")
+    return DMGPlanner(surface=DMGSurface(model=model))
+
+
 def _mesh_in_task_frame(obj: str, planner=None):
     from ..strategies.dmg.strategy import DMGPlanner
 
@@ -197,7 +207,11 @@ def score_store(
             if task not in tasks:
                 ts = get_manager().create("task", task)
                 tasks[task] = {str(t): ts.contacts["desired"][i] for i, t in enumerate(ts.task_id)}
-            row.update(contact_errors(o["object"], tasks[task][o["task_id"]], rc))
+            row.update(
+                contact_errors(
+                    o["object"], tasks[task][o["task_id"]], rc, planner=planner_for_outcome(o)
+                )
+            )
         out.append(row)
     return out
 
@@ -231,6 +245,6 @@ def stored_contact_scorer() -> Callable[[Any], dict[str, float] | None]:
         want = desired[trial.task].get(o.get("task_id"))
         if want is None or not np.all(np.isfinite(np.asarray(want, float))):
             return None
-        return contact_errors(o["object"], want, rc)
+        return contact_errors(o["object"], want, rc, planner=planner_for_outcome(o))
 
     return score

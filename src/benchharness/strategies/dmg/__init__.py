@@ -33,6 +33,14 @@ def make_planner(**kwargs):
     return DMGPlanner(**kwargs)
 
 
+def _options():
+    """``--strategy-option`` defaults: the object model (:class:`.config.DMGSurface`), e.g.
+    ``--strategy-option model=ycb`` to plan, simulate and score on the YCB scans."""
+    from .config import DMGSurface
+
+    return {"surface": DMGSurface()}
+
+
 REGISTRATIONS = [
     Registration(
         "dmg",
@@ -44,5 +52,6 @@ REGISTRATIONS = [
             "benchmarks": ["inhand"],
             "robots": ["pr2-gripper"],
         },
+        options=_options,
     )
 ]

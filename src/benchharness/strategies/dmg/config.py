@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Literal
 
-__all__ = ["DMGGripperModel", "DMGConfig", "YUMI_SMART_GRIPPER"]
+__all__ = ["DMGGripperModel", "DMGConfig", "DMGSurface", "YUMI_SMART_GRIPPER"]
 
 
 @dataclass(frozen=True)
@@ -99,3 +100,31 @@ class DMGConfig:
         import numpy as np
 
         return np.deg2rad(np.arange(self.n_angles) * self.angle_step)
+
+
+@dataclass(frozen=True)
+class DMGSurface:
+    """Which model of the object the DMG plans on, the trial simulates and the contact errors use.
+
+    ``model="generated"`` (default): the shape generated from the published
+    dimensions with edge length ``resolution``, the published task data
+    moved onto it by :mod:`.placement`. ``model="ycb"``: the vendored YCB
+    scan, which is already in the published frame (``docs/objects.md``,
+    "Frames of the published data": the DMG.ods contacts fixed it), so the
+    task data need no placement; its zero-area faces are dropped for the
+    graph (they have no normal). The same model serves planning, the
+    simulated body and G_euc / G_geo / G_min, so the contact errors are
+    measured on the surface the gripper touched. Why the generated shape is
+    still the default: docs/dmg.md, "On the YCB scans".
+    """
+
+    model: Literal["generated", "ycb"] = "generated"
+    resolution: float = 0.003  #: m, edge length of the generated model (``model="generated"``)
+
+    def __post_init__(self) -> None:
+        if self.model not in ("generated", "ycb"):
+            raise ValueError(f"surface model must be 'generated' or 'ycb', not {self.model!r}")
+        if not self.resolution > 0:
+            raise ValueError(
+                f"resolution must be a positive length in metres, not {self.resolution!r}"
+            )

@@ -227,7 +227,6 @@ def _task_set(item):
 
 def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = None) -> TrialOutcome:
     """One DMG trial on the simulator (see the module docstring)."""
-    from ...objects import load_object
     from ..pivoting.rig import RigFailure, TableRig
     from .planner import DMGNoPathError, Grasp, surface_contacts
 
@@ -263,10 +262,11 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
         return TrialOutcome(
             failure="unreachable",
             message=f"no DMG plan: {e}",
-            extra={"dmg_time_s": dmg.build_time_s},
+            extra={"dmg_time_s": dmg.build_time_s, "dmg_surface": planner.surface.model},
         )
     info = {
         "dmg_time_s": dmg.build_time_s,
+        "dmg_surface": planner.surface.model,  # the model the contact errors must be scored on
         "reached_goal_node": plan.reached_goal,
         "primitives": [
             (p.kind, round(math.degrees(p.angle), 2) if p.kind == "rotate" else round(p.length, 4))
@@ -288,7 +288,7 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
     width = float(np.linalg.norm(on[0] - on[1]))
     waypoints = plan_waypoints(dmg, plan)
     prims = group_primitives(waypoints)
-    model = load_object(obj, resolution=planner.resolution)
+    model = planner.object_model(obj)
     pre = Pose(
         setup_pose.p - setup_pose.rotation.apply([ex.setup.approach_clearance, 0.0, 0.0]),
         setup_pose.q,

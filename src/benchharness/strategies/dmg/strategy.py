@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .config import DMGConfig, DMGGripperModel
+from .config import DMGConfig, DMGGripperModel, DMGSurface
 from .placement import DMGPlacement, placement_for
 
 if TYPE_CHECKING:  # the planner module pulls in scipy/trimesh at call time only
@@ -91,7 +91,8 @@ class DMGPlanner:
     object_configs: Mapping[str, DMGConfig] = field(
         default_factory=lambda: dict(PUBLISHED_TASK_CONFIGS)
     )
-    resolution: float = 0.003
+    #: the object model planned on, simulated and scored (generated shape or YCB scan)
+    surface: DMGSurface = field(default_factory=DMGSurface)
     meshes: Mapping[str, object] = field(default_factory=dict)
     #: execution on a simulator (``run_trial``): a :class:`.execution.DMGExecConfig`, None = defaults
     execution: object = None
@@ -113,9 +114,18 @@ class DMGPlanner:
         named = {_key(k): v for k, v in self.meshes.items()}
         if _key(obj) in named:
             return named[_key(obj)]
+        surface = self.object_model(obj).surface
+        if self.surface.model == "ycb":
+            surface.update_faces(surface.nondegenerate_faces())  # a copy: the model is cached
+        return surface
+
+    def object_model(self, obj: str):
+        """The :class:`~benchharness.objects.ObjectModel` of :attr:`surface` (the simulated body too)."""
         from benchharness.objects import load_object
 
-        return load_object(obj, resolution=self.resolution).surface
+        if self.surface.model == "ycb":
+            return load_object(obj)
+        return load_object(obj, resolution=self.surface.resolution)
 
     def graph(self, obj: str):
         """The object's DMG (built on first use; ``.build_time_s`` is the DMG time)."""
@@ -127,6 +137,11 @@ class DMGPlanner:
         return self._graphs[k]
 
     def placement(self, obj: str) -> DMGPlacement:
+        if self.surface.model == "ycb":
+            ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+            return DMGPlacement(
+                _key(obj), ident, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), "YCB scan: the published frame"
+            )
         try:
             return placement_for(obj)
         except KeyError:
