@@ -1,8 +1,10 @@
 """The strategy object: plans task-file rows on our meshes, writes and scores results.
 
 Task files give grasps in the published (real-YCB) frames; the planner moves
-them onto our generated meshes with :mod:`.placement`, plans there, and maps
-the final grasp back, so results files line up with the task file. For the
+them onto our generated meshes with :mod:`.placement` (or, with
+``DMGSurface(model="ycb")``, plans on the YCB scan, already in those frames),
+plans there, and maps the final grasp back, so results files line up with the
+task file. For the
 contact metrics our mesh is exported in the published frame next to the
 results file and the desired region is written as its vertex indices.
 """
