@@ -118,6 +118,7 @@ class DMGSurface:
     still the default: docs/dmg.md, "On the YCB scans".
     """
 
+    #: the object model: the shape generated from the published dimensions, or the YCB scan
     model: Literal["generated", "ycb"] = "generated"
     resolution: float = 0.003  #: m, edge length of the generated model (``model="generated"``)
 
