@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 from benchharness.geometry import Pose
-from benchharness.objects import load_object
+from benchharness.runner.contact_regions import planner_for_outcome
 
 
 def main() -> None:
@@ -41,12 +41,9 @@ def main() -> None:
             if o.get("task_id") in seen or extra.get("rest_pose") is None:
                 continue
             seen.add(o["task_id"])
-            model = extra.get("dmg_surface", "generated")
-            m = (
-                load_object(o["object"])
-                if model == "ycb"
-                else load_object(o["object"], resolution=0.003)
-            )
+            planner = planner_for_outcome(o)  # the model the trial ran on
+            model = planner.surface.model
+            m = planner.object_model(o["object"])
             t = Pose.from_array(extra["rest_pose"]).as_matrix()
             w = np.asarray(m.surface.convex_hull.vertices) @ t[:3, :3].T + t[:3, 3]
             z0 = w[:, 2].min()

@@ -70,7 +70,6 @@ def _split_by_normal(faces: np.ndarray, normals: np.ndarray, cos_tol: float) -> 
     while len(left):
         seed = normals[left[0]]
         member = normals[left] @ seed >= cos_tol
-        member[0] = True  # the seed joins its own group whatever its normal: `left` always shrinks
         groups.append(left[member])
         left = left[~member]
     return groups
@@ -83,9 +82,10 @@ def discretise_surface(mesh, patch_size: float, patch_normal_angle: float = 30.0
     from scipy.sparse.csgraph import connected_components
 
     fn = np.asarray(mesh.face_normals, float)
-    degenerate = int(np.count_nonzero(np.einsum("ij,ij->i", fn, fn) < 0.5))
+    degenerate = int(np.count_nonzero(~(np.einsum("ij,ij->i", fn, fn) >= 0.5)))  # NaN counts too
     if degenerate:
-        # a zero-area face has no normal, so no patch to join (and no area to weigh a centre by)
+        # a zero-area face has no normal, so no patch to join (and no area to weigh a centre by):
+        # its normal would match no seed, not even its own, and the grouping below never end
         raise ValueError(
             f"the mesh has {degenerate} degenerate (zero-area) faces; drop them first: "
             "mesh.update_faces(mesh.nondegenerate_faces())"

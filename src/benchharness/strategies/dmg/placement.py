@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["DMGPlacement", "PLACEMENTS", "placement_for"]
+__all__ = ["DMGPlacement", "PLACEMENTS", "identity_placement", "placement_for"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,12 @@ class DMGPlacement:
 
 
 _I = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def identity_placement(name: str, note: str) -> DMGPlacement:
+    """The published frame taken as ours: for a model already in it, or a task assumed in ours."""
+    return DMGPlacement(name, _I, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), note)
+
 
 #: Our spatula blade slopes about 11 degrees where the published grasps are,
 #: the scanned one about 20: the placement turns the published frame by the

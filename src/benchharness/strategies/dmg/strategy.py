@@ -4,9 +4,9 @@ Task files give grasps in the published (real-YCB) frames; the planner moves
 them onto our generated meshes with :mod:`.placement` (or, with
 ``DMGSurface(model="ycb")``, plans on the YCB scan, already in those frames),
 plans there, and maps the final grasp back, so results files line up with the
-task file. For the
-contact metrics our mesh is exported in the published frame next to the
-results file and the desired region is written as its vertex indices.
+task file. For the contact metrics our mesh is exported in the published frame
+next to the results file and the desired region is written as its vertex
+indices.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .config import DMGConfig, DMGGripperModel, DMGSurface
-from .placement import DMGPlacement, placement_for
+from .placement import DMGPlacement, identity_placement, placement_for
 
 if TYPE_CHECKING:  # the planner module pulls in scipy/trimesh at call time only
     from .planner import DMGPath
@@ -140,17 +140,11 @@ class DMGPlanner:
 
     def placement(self, obj: str) -> DMGPlacement:
         if self.surface.model == "ycb":
-            ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-            return DMGPlacement(
-                _key(obj), ident, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), "YCB scan: the published frame"
-            )
+            return identity_placement(_key(obj), "YCB scan: the published frame")
         try:
             return placement_for(obj)
         except KeyError:
-            ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-            return DMGPlacement(
-                _key(obj), ident, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), "task assumed in our frame"
-            )
+            return identity_placement(_key(obj), "task assumed in our frame")
 
     def plan_task(self, tasks, i: int) -> DMGTaskPlan:
         """Plan row ``i`` of a :class:`~benchharness.inhand.records.TaskSet`.
