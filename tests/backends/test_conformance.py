@@ -19,6 +19,8 @@ from backend_scenes import (
     ASSETS,
     CUBE_HALF,
     CUBE_MASS,
+    FINGER_D,
+    FINGER_K,
     GRASP_Z,
     GRIPPER_URDF,
     OPEN_Q,
@@ -534,6 +536,82 @@ def test_attach_detach(backend: Backend):
     backend.attach(grip, "palm", ball, None, Pose([0, 0, -0.05]))
     backend.step(120)
     assert np.linalg.norm(backend.get_pose(ball).p - [1.0, 0, 0.25]) < 2e-3
+
+
+def _coupling_or_skip(backend: Backend) -> None:
+    if (
+        not backend.capabilities.joint_coupling
+    ):  # an optional capability: such a backend must refuse
+        grip = backend.load_urdf(GRIPPER_URDF, Pose())
+        with pytest.raises(CapabilityError):
+            backend.couple_joints(grip, "right_finger", "left_finger")
+        pytest.skip(f"{type(backend).__name__} has no joint couplings")
+
+
+@pytest.mark.parametrize("multiplier", [1.0, 0.5])
+def test_couple_joints_drives_the_follower(backend: Backend, multiplier: float):
+    """Only the left finger is driven (to 40 mm); the coupled right one stands at multiplier x 40 mm.
+
+    The right finger's own drive is off (cap 0), so nothing but the coupling can move it; the
+    analytic answer is the coupling's definition, ``q_follower = multiplier * q_leader``.
+    """
+    _coupling_or_skip(backend)
+    grip = backend.load_urdf(GRIPPER_URDF, Pose())
+    backend.set_joint_positions(grip, [0.3, 0.02, 0.02 * multiplier])
+    backend.couple_joints(grip, "right_finger", "left_finger", multiplier)
+    backend.set_joint_targets(grip, [0.3], joints=["lift"], stiffness=2.0e4, damping=1.0e3)
+    backend.set_joint_targets(
+        grip, [0.04], joints=["left_finger"], stiffness=2000.0, damping=40.0, force_limit=40.0
+    )
+    backend.set_joint_targets(grip, [0.0], joints=["right_finger"], force_limit=0.0)
+    backend.step(240)
+    q = backend.get_joint_state(grip).positions
+    assert q[1] == pytest.approx(0.04, abs=1e-3)
+    assert q[2] == pytest.approx(multiplier * q[1], abs=2e-4)
+    backend.remove_body(grip)  # the coupling goes with its body
+    backend.step(1)
+
+
+@pytest.mark.parametrize("coupled", [True, False], ids=["coupled", "independent"])
+def test_coupled_fingers_centre_what_they_squeeze(backend: Backend, coupled: bool):
+    """A cube resting 6 mm off the fingers' centre, squeezed by two equal force-capped drives (5 N each).
+
+    Coupled (the fingers symmetric, as one mechanism moves them; they start open, symmetric):
+    they can close only symmetrically, so they push the cube to the centre, within 0.5 mm.
+    Independent (the control; they start with both pads on the cube): two equal forces balance
+    wherever the cube is, so it stays off centre -- a neutral pair, which is what the coupling
+    removes.
+    """
+    if coupled:
+        _coupling_or_skip(backend)
+    s = gripper_scene(backend)
+    b = backend
+    off = 0.006
+    b.set_pose(s.cube, Pose([0.0, off, CUBE_HALF]))
+    if coupled:
+        b.couple_joints(s.gripper, "right_finger", "left_finger")
+    else:  # each pad's inner face on the cube (left finger along +y, right along -y)
+        q = [CUBE_HALF + off + PAD_OFFSET, CUBE_HALF - off + PAD_OFFSET]
+        b.set_joint_positions(s.gripper, q, joints=["left_finger", "right_finger"])
+        b.set_joint_targets(
+            s.gripper,
+            q,
+            joints=["left_finger", "right_finger"],
+            stiffness=FINGER_K,
+            damping=FINGER_D,
+        )
+    b.step(60)
+    b.set_joint_targets(
+        s.gripper,
+        [0.0, 0.0],
+        joints=["left_finger", "right_finger"],
+        stiffness=FINGER_K,
+        damping=FINGER_D,
+        force_limit=5.0,
+    )
+    b.step(240)
+    y = float(s.cube_in_palm()[1])
+    assert y == pytest.approx(0.0 if coupled else off, abs=5e-4)
 
 
 def test_remove_and_replace_without_jump(backend: Backend):

@@ -29,6 +29,37 @@ def test_description_is_physical_and_cited():
             assert text[k - 1].strip().startswith("<!--"), line
 
 
+def test_fingers_mimic_as_published():
+    """pr2_description gripper_v0/gripper.urdf.xacro (PR2/pr2_common c36a5c9, line 80): ``*_r_finger_joint``
+    carries ``<mimic joint="${prefix}_l_finger_joint" multiplier="1" offset="0"/>``: one DOF."""
+    from benchharness.robots.config import JointMimic
+    from benchharness.robots.pr2 import pr2_config
+    from benchharness.robots.pr2_gripper import pr2_gripper_config
+
+    (grip,) = pr2_gripper_config().grippers
+    assert grip.mimic == (JointMimic("r_gripper_r_finger_joint", "r_gripper_l_finger_joint", 1.0),)
+    # the PR2's arms keep independent fingers until their Rubik's figures are re-measured (docs/robots.md)
+    assert all(g.mimic == () for g in pr2_config().grippers)
+
+
+def test_spawn_refuses_a_backend_that_cannot_couple_joints():
+    """The coupling is part of the robot: a backend without it gets a clear error, not a silent stand-in."""
+    from dataclasses import replace
+
+    from benchharness.backends.interface import CapabilityError
+
+    m = get_manager()
+    b = m.create("backend", "pybullet", config=PhysicsConfig())
+    try:
+        b.capabilities = replace(b.capabilities, joint_coupling=False)
+        with pytest.raises(
+            CapabilityError, match="r_gripper_r_finger_joint mimics r_gripper_l_finger_joint"
+        ):
+            m.create("robot", "pr2-gripper").spawn(b)
+    finally:
+        b.close()
+
+
 @pytest.mark.parametrize("backend", ["pybullet", "sapien"])
 def test_stage_puts_the_tool_where_commanded(backend):
     """Teleport the stage to joint values from ``stage_joints_for`` and read the tool frame back from the engine."""
@@ -62,17 +93,25 @@ def test_vertical_fingers_press_equally_on_what_they_hold(backend, force):
     """Fingers closing vertically on a fixed block press it with the force asked for, both alike.
 
     The real gripper's fingers share one motor through the mimic linkage, so their weights (2.1 N each)
-    cancel; the model's independent finger drives carry their own weight (``gravity_compensated``) and
-    close together at the published gap speed (``close_speed``). Without that, the upper pad pressed
-    twice a finger's weight harder than the lower one: a net push on a cube held by the other hand.
+    cancel; the PR2 arms' independent finger drives (``symmetric=False``) carry their own weight
+    (``gravity_compensated``) and close together at the published gap speed (``close_speed``). Without that, the upper pad pressed twice a finger's weight
+    harder than the lower one: a net push on a cube held by the other hand.
     """
+    from dataclasses import replace
+
     from benchharness.backends.interface import Box
     from benchharness.robots.descriptions.pr2 import pad_setback
+    from benchharness.robots.pr2 import pr2_gripper_part
+    from benchharness.robots.pr2_gripper import pr2_gripper_config
+    from benchharness.robots.robot import Robot
 
     m = get_manager()
     b = m.create("backend", backend, config=PhysicsConfig())
     try:
-        robot = m.create("robot", "pr2-gripper")
+        # the PR2 arms' independent fingers: on a *fixed* block a coupled pair's two pad forces are
+        # set by how far the stage sags off the block's centre (tens of micrometres), not by the drives
+        cfg = pr2_gripper_config()
+        robot = Robot(replace(cfg, grippers=(pr2_gripper_part("r", "gripper", symmetric=False),)))
         robot.spawn(b)
         arm, grip = robot.arm("stage"), robot.gripper("gripper")
         # approach along world x, the fingers closing along world z

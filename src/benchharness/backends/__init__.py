@@ -54,8 +54,8 @@ __all__ = [
 ]
 
 #: capability flags, known without importing the engines (the classes carry the same values)
-PYBULLET_CAPABILITIES = Capabilities(camera=True, gravity_torques=True)
-SAPIEN_CAPABILITIES = Capabilities(camera=False, gravity_torques=True)
+PYBULLET_CAPABILITIES = Capabilities(camera=True, gravity_torques=True, joint_coupling=True)
+SAPIEN_CAPABILITIES = Capabilities(camera=False, gravity_torques=True, joint_coupling=True)
 
 
 def create_pybullet(config: PhysicsConfig | None = None) -> Backend:

@@ -79,6 +79,8 @@ class Capabilities:
     camera: bool = False  #: :meth:`Backend.render` returns images (read by ``run --video``)
     #: :meth:`Backend.gravity_torques` is the engine's own inverse dynamics (read by ``Robot``)
     gravity_torques: bool = False
+    #: :meth:`Backend.couple_joints` ties two joints of a body (a hand's ``<mimic>``; read by ``Robot``)
+    joint_coupling: bool = False
 
 
 @dataclass(frozen=True)
@@ -615,6 +617,18 @@ class Backend(abc.ABC):
 
     @abc.abstractmethod
     def detach(self, constraint: int) -> None: ...
+
+    def couple_joints(
+        self, body: BodyId, follower: str, leader: str, multiplier: float = 1.0
+    ) -> None:
+        """Tie two one-degree-of-freedom joints of ``body``: ``q_follower = multiplier * q_leader``.
+
+        A mechanism's coupling (a URDF ``<mimic>``) as an engine constraint
+        that lasts as long as the body: forces on either joint act on both,
+        and each joint's own drive still applies. Backends without it
+        (``capabilities.joint_coupling`` False) raise :class:`CapabilityError`.
+        """
+        raise CapabilityError(f"{type(self).__name__} cannot couple joints (joint_coupling)")
 
     def render(self, camera: CameraSpec) -> np.ndarray:
         """An RGB image (height, width, 3) uint8. Backends without a renderer raise."""

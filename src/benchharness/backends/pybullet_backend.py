@@ -95,6 +95,12 @@ _MAX_COMPOUND_SHAPES = 16
 #: rays hit (bench/bench_object_surfaces.py, docs/backends.md "Object surfaces")
 _MESH_MARGIN = 1.0e-4
 _ATTACH_MAX_FORCE = 1.0e5
+#: N (or N m): the most a joint coupling (:meth:`PyBulletBackend.couple_joints`) transmits; the
+#: PR2 gripper's mimic linkage is rated ``finger_joint_effort_limit`` 1000 (gripper_v0/gripper.urdf.xacro)
+_COUPLING_MAX_FORCE = 1000.0
+#: position error correction of a joint coupling per step (Bullet's ERP; 0 would couple velocities only
+#: and let a start-up offset between the joints stay)
+_COUPLING_ERP = 0.2
 
 
 def _convex_hull(s: MeshShape) -> Any:
@@ -113,6 +119,7 @@ class _Body(BodyRecord):
     uid: int
     link_index: dict[str, int] = field(default_factory=dict)  #: URDF link -> pybullet index
     joint_index: list[int] = field(default_factory=list)  #: pybullet joint index, per movable joint
+    couplings: list[int] = field(default_factory=list)  #: gear constraints (couple_joints)
     base_inertial: Pose = field(default_factory=Pose)  #: base inertial frame in the base link frame
     # the drive law's state and caches, per movable joint (position in self.joints)
     q_prev: np.ndarray | None = None  #: joint positions at the start of the last driven step
@@ -823,6 +830,8 @@ class PyBulletBackend(Backend):
             info = pb.getConstraintInfo(pc, physicsClientId=self._cid)
             if b.uid in (info[0], info[2]):
                 self.detach(c)
+        for cid in b.couplings:
+            pb.removeConstraint(cid, physicsClientId=self._cid)
         pb.removeBody(b.uid, physicsClientId=self._cid)
         self._bodies.pop(body)
         self._step_lists = None
@@ -1107,6 +1116,42 @@ class PyBulletBackend(Backend):
         self._next_constraint += 1
         self._constraints[h] = cid
         return h
+
+    def couple_joints(
+        self, body: BodyId, follower: str, leader: str, multiplier: float = 1.0
+    ) -> None:
+        """A Bullet gear constraint between the two joints' links (follower as A, leader as B).
+
+        Bullet's multibody gear keeps ``v_A + ratio * v_B = 0`` and, with an
+        ERP, corrects the position error too; ``ratio = -multiplier`` gives
+        ``q_follower = multiplier * q_leader``.
+        """
+        b = self._b(body)
+        fi, li = b.joint_indices([follower, leader])
+        for i in (fi, li):
+            if b.joints[i].type not in ("prismatic", "revolute", "continuous"):
+                raise BackendError(f"joint {b.joints[i].name!r} is not a one-axis joint")
+        if float(multiplier) == 0.0:
+            raise BackendError("a joint coupling needs a non-zero multiplier")
+        cid = pb.createConstraint(
+            b.uid,
+            b.joint_index[fi],
+            b.uid,
+            b.joint_index[li],
+            pb.JOINT_GEAR,
+            [0, 0, 1],  # unused by a multibody gear: it acts on the joints' own axes
+            parentFramePosition=[0, 0, 0],
+            childFramePosition=[0, 0, 0],
+            physicsClientId=self._cid,
+        )
+        pb.changeConstraint(
+            cid,
+            gearRatio=-float(multiplier),
+            maxForce=_COUPLING_MAX_FORCE,
+            erp=_COUPLING_ERP,
+            physicsClientId=self._cid,
+        )
+        b.couplings.append(cid)
 
     def check_finite(self, bodies: Sequence[BodyId]) -> None:
         for h in bodies:

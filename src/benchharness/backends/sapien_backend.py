@@ -109,6 +109,12 @@ _FRICTION_DAMPING = 1.0e4  #: damping of the velocity drive that models Coulomb 
 _ATTACH_STIFFNESS = 1.0e7
 _ATTACH_DAMPING = 1.0e4
 _ATTACH_MAX_FORCE = 1.0e5
+#: A joint coupling (:meth:`SapienBackend.couple_joints`) is a PhysX fixed tendon, a spring on
+#: ``multiplier * q_leader - q_follower`` solved with the articulation: N/m (N m/rad) and N s/m. Stiff
+#: enough that a 10 N difference between the fingers' loads moves them 0.1 mm apart, damped well
+#: beyond critical for a PR2 finger (0.17 kg) so that it does not ring.
+_COUPLING_STIFFNESS = 1.0e5
+_COUPLING_DAMPING = 1.0e3
 # x axis -> z axis: SAPIEN cylinders run along x, ours along z
 _X_TO_Z = Pose(np.zeros(3), np.array([0.0, -math.sqrt(0.5), 0.0, math.sqrt(0.5)]))
 
@@ -844,6 +850,38 @@ class SapienBackend(Backend):
         for comp in (body, drive.parent):
             if comp is not None and hasattr(comp, "wake_up"):
                 comp.wake_up()
+
+    def couple_joints(
+        self, body: BodyId, follower: str, leader: str, multiplier: float = 1.0
+    ) -> None:
+        """A PhysX fixed tendon over the two joints, rooted at their common parent link.
+
+        PhysX has no mimic joints; a fixed tendon's length is a weighted sum
+        of joint positions and its spring pulls ``multiplier * q_leader -
+        q_follower`` to zero inside the articulation solve (implicit, so the
+        stiff coupling stays stable). The two joints must hang from one link.
+        """
+        b = self._b(body)
+        fi, li = b.joint_indices([follower, leader])
+        jf, jl = b.joints[fi], b.joints[li]
+        for j in (jf, jl):
+            if j.type not in ("prismatic", "revolute", "continuous"):
+                raise BackendError(f"joint {j.name!r} is not a one-axis joint")
+        if b.articulation is None or jf.parent_link != jl.parent_link:
+            raise BackendError(
+                f"cannot couple {follower!r} to {leader!r}: the joints must share a parent link"
+            )
+        m = float(multiplier)
+        if m == 0.0:
+            raise BackendError("a joint coupling needs a non-zero multiplier")
+        b.articulation.create_fixed_tendon(
+            [b.links[jl.parent_link], b.links[jl.child_link], b.links[jf.child_link]],
+            [0.0, m, -1.0],
+            [0.0, 1.0 / m, -1.0],
+            rest_length=0.0,
+            stiffness=_COUPLING_STIFFNESS,
+            damping=_COUPLING_DAMPING,
+        )
 
     def check_finite(self, bodies: Sequence[BodyId]) -> None:
         for h in bodies:

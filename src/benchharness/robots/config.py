@@ -27,6 +27,7 @@ __all__ = [
     "ArmConfig",
     "FingertipLinkage",
     "GripperConfig",
+    "JointMimic",
     "RobotConfig",
     "gains_from_effort",
     "robot_meta",
@@ -52,6 +53,28 @@ class ArmConfig:
     gravity_carried: bool = (
         False  #: gravity torque is carried by a counterbalance, not by the motors (PR2)
     )
+
+
+@dataclass(frozen=True)
+class JointMimic:
+    """A joint that the hand's mechanism ties to another: ``q_follower = multiplier * q_leader``.
+
+    The URDF's ``<mimic>``, made a constraint of the engine
+    (:meth:`~benchharness.backends.interface.Backend.couple_joints`), not a
+    controller target: a load that pushes one finger out pulls the other in
+    through the mechanism, whatever the drives do. Why: a gripper whose two
+    fingers one transmission moves (the PR2's, pr2_description
+    ``gripper_v0/gripper.urdf.xacro``: ``*_r_finger_joint`` mimics
+    ``*_l_finger_joint`` with multiplier 1) keeps its fingers symmetric about
+    the tool frame. Two independent force-capped drives do not: under a light
+    squeeze they are a neutral pair, and what they hold can drift or lean
+    towards either finger at no cost (an object standing on a table topples
+    sideways; docs/pivoting.md, "Symmetric fingers").
+    """
+
+    follower: str
+    leader: str
+    multiplier: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -101,7 +124,9 @@ class GripperConfig:
     hand couples mechanically (mimic joints) are driven, since PhysX has no
     mimic joints. Each joint is an independent PD drive towards its coupled
     target, capped at ``force_limit``: a blocked proximal link does not stop
-    its distal link, much like the BarrettHand's breakaway clutch.
+    its distal link, much like the BarrettHand's breakaway clutch. Joints that
+    the mechanism itself ties together (a parallel gripper's two fingers)
+    are listed in ``mimic`` as well: that makes an engine constraint of it.
     """
 
     name: str  #: group name, e.g. ``"left_gripper"``
@@ -127,6 +152,9 @@ class GripperConfig:
     #: fingertip joints that follow their finger's lateral joint on a linkage's arc (not in ``joints``:
     #: the actuators, forces and openings stay those of ``joints``)
     linkages: tuple[FingertipLinkage, ...] = ()
+    #: joints of ``joints`` that the mechanism ties together (:class:`JointMimic`), as engine
+    #: constraints made when the robot spawns; each joint keeps its own drive and force cap
+    mimic: tuple[JointMimic, ...] = ()
     #: each joint's drive also carries the weight its links put on it (gravity feed-forward, refreshed
     #: every control tick), so that ``force_limit`` is the force the finger presses with in any
     #: orientation. Why: a hand whose fingers one transmission couples (the PR2's: one motor, mimic

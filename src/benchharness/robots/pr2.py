@@ -8,7 +8,14 @@ from typing import TYPE_CHECKING
 
 from ..geometry import Pose
 from ..paths import robots_dir
-from .config import ArmConfig, FingertipLinkage, GripperConfig, RobotConfig, gains_from_effort
+from .config import (
+    ArmConfig,
+    FingertipLinkage,
+    GripperConfig,
+    JointMimic,
+    RobotConfig,
+    gains_from_effort,
+)
 from .descriptions.pr2 import (
     FINGER_RADIUS,
     FINGER_TRAVEL,
@@ -65,13 +72,20 @@ PR2_FULL_URDF_LINK_MAP: Mapping[str, str] = {
 }
 
 
-def pr2_gripper_part(s: str, name: str, grip_force: float = 20.0) -> GripperConfig:
+def pr2_gripper_part(
+    s: str, name: str, grip_force: float = 20.0, *, symmetric: bool = True
+) -> GripperConfig:
     """The PR2 gripper on side ``s`` (``"l"``/``"r"``): one half-opening actuator, force in N per finger.
 
     The two lateral finger joints take the command; each fingertip follows its
     finger on the four-bar's arc (:class:`FingertipLinkage`, figures in
     :mod:`.descriptions.pr2`), so the pads slide back along the approach as the
-    gripper opens, as the real ones do.
+    gripper opens, as the real ones do. ``symmetric``: the right finger
+    mimics the left one (:class:`JointMimic`, multiplier 1, as
+    pr2_description's ``*_r_finger_joint`` does), so the fingers stay
+    symmetric about the tool frame under any load; False: two independent
+    finger drives (the model before 2026-12-05, which the PR2's Rubik's
+    figures were measured with).
     """
     lateral = PAD_GAP + PAD_FACE_Y - FINGER_Y  # leader value 0 -> the real tip's lateral arm
     linkages = tuple(
@@ -100,6 +114,11 @@ def pr2_gripper_part(s: str, name: str, grip_force: float = 20.0) -> GripperConf
         tcp_link=f"{s}_gripper_tcp",
         kind="parallel",
         linkages=linkages,
+        mimic=(
+            (JointMimic(f"{s}_gripper_r_finger_joint", f"{s}_gripper_l_finger_joint"),)
+            if symmetric
+            else ()
+        ),
         # one motor drives both fingers through the screw and the mimic linkage: the finger weights cancel
         gravity_compensated=True,
         # l_gripper_joint (the gap) velocity="0.2" m/s (pr2_description gripper_v0/gripper.urdf.xacro): 0.1 per finger
@@ -127,7 +146,9 @@ def pr2_config(
                 gravity_carried=True,
             )
         )
-        grippers.append(pr2_gripper_part(s, f"{side}_gripper"))
+        # independent fingers: the Rubik's Table I figures (BENCHMARKS.md) were measured with them and
+        # are not yet re-measured with the published symmetric coupling (docs/robots.md, "PR2 gripper")
+        grippers.append(pr2_gripper_part(s, f"{side}_gripper", symmetric=False))
         sign = 1.0 if s == "l" else -1.0
         for j, v in HOME_ARM.items():
             mirrored = j in (

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..backends.interface import Backend, BodyId
+from ..backends.interface import Backend, BodyId, CapabilityError
 from ..geometry import Pose
 from .config import RobotConfig
 from .description import UrdfJoint, downstream_links, read_joints, read_links
@@ -189,12 +189,24 @@ class Robot:
         self._gcache = None
         q0 = self.home() if q is None else self.with_linkages(np.asarray(q, dtype=float))
         backend.set_joint_positions(self.body, q0)
+        self._couple(backend)
         self._targets = q0.copy()
         self.hold()
         for g in self.grippers.values():  # hands keep their home shape
             qg = q0[[self.joint_names.index(j) for j in g.joints]]
             g.set_command(np.linalg.lstsq(g.coupling, qg, rcond=None)[0])
         return self.body
+
+    def _couple(self, backend: Backend) -> None:
+        """Make each hand's ``mimic`` couplings engine constraints (see :class:`~.config.JointMimic`)."""
+        mimics = [m for g in self.config.grippers for m in g.mimic]
+        if mimics and not backend.capabilities.joint_coupling:
+            raise CapabilityError(
+                f"robot {self.name!r} needs joint couplings ({mimics[0].follower} mimics "
+                f"{mimics[0].leader}), which backend {type(backend).__name__} cannot make"
+            )
+        for m in mimics:
+            backend.couple_joints(self.body, m.follower, m.leader, m.multiplier)
 
     def _require(self) -> Backend:
         if self.backend is None or self.body is None:

@@ -24,8 +24,10 @@ Simplifications (also in robots/pr2/README.md):
   every opening, parallel to the palm; the proximal bar is a box that
   translates with the finger (the real link turns), and a load along the
   approach is carried by the fingertip's stiff drive, not the linkage. The
-  fingers are coupled in the controller, not by ``<mimic>`` (PhysX has no
-  mimic joints);
+  file has no ``<mimic>`` (PhysX has no mimic joints): the fingers take one
+  command in the controller, and the published left-right mimic is an engine
+  constraint the robot makes at spawn (``GripperConfig.mimic``; on the
+  ``pr2-gripper``, not yet on the PR2's arms: docs/robots.md);
 * forearm roll and wrist roll are ``continuous``, as on the robot: a twist
   or a hand-over turn can carry on past +/-pi without the arm having to
   switch IK branch (unwind) mid-turn. IK searches them over +/-pi and
