@@ -11,7 +11,7 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 pytest.importorskip("networkx")
 
-from benchharness.strategies.dmg.config import DMGConfig, DMGGripperModel  # noqa: E402
+from benchharness.strategies.dmg.config import DMGConfig, DMGGripperModel, DMGSurface  # noqa: E402
 from benchharness.strategies.dmg.graph import build_graph  # noqa: E402
 from benchharness.strategies.dmg.planner import Grasp, Rotate, Translate, plan  # noqa: E402
 
@@ -143,7 +143,8 @@ def gelatin():
     root = Path(__file__).resolve().parents[1]
     tasks = read_tasks(root / "tasks/inhand/level3_dmg_tasks.csv")
     i = list(tasks.object).index("gelatin box")
-    planner = make_planner()
+    # the generated shape and its placement (the scans, the default: tests/test_dmg_scan.py)
+    planner = make_planner(surface=DMGSurface(model="generated"))
     return tasks, i, planner, planner.plan_task(tasks, i)
 
 
@@ -198,7 +199,7 @@ def test_all_published_tasks_reach_their_goal_nodes():
     from benchharness.strategies.dmg import make_planner
 
     tasks = read_tasks(Path(__file__).resolve().parents[1] / "tasks/inhand/level3_dmg_tasks.csv")
-    for tp in make_planner().plan_tasks(tasks):
+    for tp in make_planner(surface=DMGSurface(model="generated")).plan_tasks(tasks):
         i = list(tasks.task_id).index(tp.task_id)
         assert tp.plan.reached_goal, tp.task_id
         miss = np.linalg.norm(tp.final_contacts - tasks.contacts["desired"][i, :2], axis=1)

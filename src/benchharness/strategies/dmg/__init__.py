@@ -34,8 +34,9 @@ def make_planner(**kwargs):
 
 
 def _options():
-    """``--strategy-option`` defaults: the object model (:class:`.config.DMGSurface`), e.g.
-    ``--strategy-option model=ycb`` to plan, simulate and score on the YCB scans."""
+    """``--strategy-option`` defaults: the object model (:class:`.config.DMGSurface`; the YCB
+    scans), e.g. ``--strategy-option model=generated`` to plan, simulate and score on the shapes
+    generated from the published dimensions."""
     from .config import DMGSurface
 
     return {"surface": DMGSurface()}

@@ -106,20 +106,22 @@ class DMGConfig:
 class DMGSurface:
     """Which model of the object the DMG plans on, the trial simulates and the contact errors use.
 
-    ``model="generated"`` (default): the shape generated from the published
-    dimensions with edge length ``resolution``, the published task data
-    moved onto it by :mod:`.placement`. ``model="ycb"``: the vendored YCB
-    scan, which is already in the published frame (``docs/objects.md``,
-    "Frames of the published data": the DMG.ods contacts fixed it), so the
-    task data need no placement; its zero-area faces are dropped for the
-    graph (they have no normal). The same model serves planning, the
-    simulated body and G_euc / G_geo / G_min, so the contact errors are
-    measured on the surface the gripper touched. Why the generated shape is
-    still the default: docs/dmg.md, "On the YCB scans".
+    ``model="ycb"`` (default): the vendored YCB scan, which is already in the
+    published frame (``docs/objects.md``, "Frames of the published data":
+    the DMG.ods contacts fixed it), so the task data need no placement; its
+    zero-area faces are dropped for the graph (they have no normal).
+    ``model="generated"``: the shape generated from the published dimensions
+    with edge length ``resolution``, the published task data moved onto it by
+    :mod:`.placement` (the default until 2026-12-05; ``--strategy-option
+    model=generated``). The same model serves planning, the simulated body
+    and G_euc / G_geo / G_min, so the contact errors are measured on the
+    surface the gripper touched. Why the scan: the paper's objects are the
+    YCB objects, and its G_min are the scans' (docs/dmg.md, "On the YCB
+    scans").
     """
 
-    #: the object model: the shape generated from the published dimensions, or the YCB scan
-    model: Literal["generated", "ycb"] = "generated"
+    #: the object model: the YCB scan, or the shape generated from the published dimensions
+    model: Literal["generated", "ycb"] = "ycb"
     resolution: float = 0.003  #: m, edge length of the generated model (``model="generated"``)
 
     def __post_init__(self) -> None:

@@ -1,10 +1,10 @@
 """The strategy object: plans task-file rows on our meshes, writes and scores results.
 
-Task files give grasps in the published (real-YCB) frames; the planner moves
-them onto our generated meshes with :mod:`.placement` (or, with
-``DMGSurface(model="ycb")``, plans on the YCB scan, already in those frames),
-plans there, and maps the final grasp back, so results files line up with the
-task file. For the contact metrics our mesh is exported in the published frame
+Task files give grasps in the published (real-YCB) frames; by default the
+planner plans on the YCB scan, already in those frames (``DMGSurface``); with
+``DMGSurface(model="generated")`` it moves them onto our generated meshes with
+:mod:`.placement`, plans there, and maps the final grasp back, so results files
+line up with the task file either way. For the contact metrics our mesh is exported in the published frame
 next to the results file and the desired region is written as its vertex
 indices.
 """
@@ -86,7 +86,7 @@ class DMGPlanner:
     Graphs are built lazily, once per object, and cached on the instance.
     ``object_configs`` overrides ``config`` per object (default:
     :data:`PUBLISHED_TASK_CONFIGS`); ``meshes`` may supply a mesh per object
-    name (in the task frame's *our* placement) instead of the generated one.
+    name (in the task frame's *our* placement) instead of the ``surface`` model's.
     """
 
     config: DMGConfig = field(default_factory=DMGConfig)
