@@ -38,8 +38,10 @@ def test_fingers_mimic_as_published():
 
     (grip,) = pr2_gripper_config().grippers
     assert grip.mimic == (JointMimic("r_gripper_r_finger_joint", "r_gripper_l_finger_joint", 1.0),)
-    # the PR2's arms keep independent fingers until their Rubik's figures are re-measured (docs/robots.md)
-    assert all(g.mimic == () for g in pr2_config().grippers)
+    assert [g.mimic for g in pr2_config().grippers] == [
+        (JointMimic(f"{s}_gripper_r_finger_joint", f"{s}_gripper_l_finger_joint", 1.0),)
+        for s in "lr"
+    ]
 
 
 def test_spawn_refuses_a_backend_that_cannot_couple_joints():
@@ -93,7 +95,7 @@ def test_vertical_fingers_press_equally_on_what_they_hold(backend, force):
     """Fingers closing vertically on a fixed block press it with the force asked for, both alike.
 
     The real gripper's fingers share one motor through the mimic linkage, so their weights (2.1 N each)
-    cancel; the PR2 arms' independent finger drives (``symmetric=False``) carry their own weight
+    cancel; independent finger drives (``symmetric=False``, the model before the coupling) carry their own weight
     (``gravity_compensated``) and close together at the published gap speed (``close_speed``). Without that, the upper pad pressed twice a finger's weight
     harder than the lower one: a net push on a cube held by the other hand.
     """
@@ -108,7 +110,7 @@ def test_vertical_fingers_press_equally_on_what_they_hold(backend, force):
     m = get_manager()
     b = m.create("backend", backend, config=PhysicsConfig())
     try:
-        # the PR2 arms' independent fingers: on a *fixed* block a coupled pair's two pad forces are
+        # independent fingers: on a *fixed* block a coupled pair's two pad forces are
         # set by how far the stage sags off the block's centre (tens of micrometres), not by the drives
         cfg = pr2_gripper_config()
         robot = Robot(replace(cfg, grippers=(pr2_gripper_part("r", "gripper", symmetric=False),)))

@@ -84,8 +84,7 @@ def pr2_gripper_part(
     mimics the left one (:class:`JointMimic`, multiplier 1, as
     pr2_description's ``*_r_finger_joint`` does), so the fingers stay
     symmetric about the tool frame under any load; False: two independent
-    finger drives (the model before 2026-12-05, which the PR2's Rubik's
-    figures were measured with).
+    finger drives (the model before 2026-12-05; a diagnostic now).
     """
     lateral = PAD_GAP + PAD_FACE_Y - FINGER_Y  # leader value 0 -> the real tip's lateral arm
     linkages = tuple(
@@ -146,9 +145,7 @@ def pr2_config(
                 gravity_carried=True,
             )
         )
-        # independent fingers: the Rubik's Table I figures (BENCHMARKS.md) were measured with them and
-        # are not yet re-measured with the published symmetric coupling (docs/robots.md, "PR2 gripper")
-        grippers.append(pr2_gripper_part(s, f"{side}_gripper", symmetric=False))
+        grippers.append(pr2_gripper_part(s, f"{side}_gripper"))
         sign = 1.0 if s == "l" else -1.0
         for j, v in HOME_ARM.items():
             mirrored = j in (

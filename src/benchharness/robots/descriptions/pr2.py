@@ -26,8 +26,8 @@ Simplifications (also in robots/pr2/README.md):
   approach is carried by the fingertip's stiff drive, not the linkage. The
   file has no ``<mimic>`` (PhysX has no mimic joints): the fingers take one
   command in the controller, and the published left-right mimic is an engine
-  constraint the robot makes at spawn (``GripperConfig.mimic``; on the
-  ``pr2-gripper``, not yet on the PR2's arms: docs/robots.md);
+  constraint the robot makes at spawn (``GripperConfig.mimic``;
+  docs/robots.md, "PR2 gripper: symmetric fingers");
 * forearm roll and wrist roll are ``continuous``, as on the robot: a twist
   or a hand-over turn can carry on past +/-pi without the arm having to
   switch IK branch (unwind) mid-turn. IK searches them over +/-pi and
