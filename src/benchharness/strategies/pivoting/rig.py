@@ -270,9 +270,13 @@ class TableRig:
         ``centred=True``: first saturated (to make contact), then each finger
         aimed ``force / k`` inside the measured mean opening with the cap at
         1.5 x ``force``: two springs pressing ``force`` that push the object
-        back between them. Why: two saturated drives are a neutral mode, the
-        fingers and the object then creep together along the grasp axis
-        (measured: 0.3 mm/s in a 5 s hold), which a firm grasp must not do.
+        back between them. Why: two independent saturated drives are a neutral
+        mode, the fingers and the object then creep together along the grasp
+        axis (measured: 0.3 mm/s in a 5 s hold), which a firm grasp must not
+        do. The ``pr2-gripper``'s fingers are now coupled as the published
+        mimic couples them (docs/robots.md, "PR2 gripper: symmetric fingers"),
+        which removes that neutral mode mechanically; the centring is kept (the
+        measured figures were made with it).
         """
         f = float(force)
         wait = self.config.grip.regrip_time if wait is None else wait
