@@ -80,7 +80,12 @@ def test_pybullet_keeps_every_convex_piece_of_a_scan():
     assert hits.hit.all(), np.flatnonzero(~hits.hit)
 
 
-def test_pybullet_refuses_a_mixed_compound_it_would_truncate():
+def test_pybullet_refuses_a_mixed_compound_it_would_truncate(tmp_path, monkeypatch):
+    """Refused with a clear error, and the hull file already written for its mesh is gone too
+    (it was left in the temporary directory, one per test-suite run, until 2026-12-05)."""
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     be = get_manager().create("backend", "pybullet")
     cube = MeshShape(
         vertices=np.array([[x, y, z] for x in (0, 0.01) for y in (0, 0.01) for z in (0, 0.01)]),
@@ -90,5 +95,6 @@ def test_pybullet_refuses_a_mixed_compound_it_would_truncate():
     try:
         with pytest.raises(BackendError, match="17 collision shapes"):
             be.add_body(shapes, Pose(), 0.1)
+        assert not [p.name for p in tmp_path.glob("bh_hull_*")]
     finally:
         be.close()

@@ -30,10 +30,20 @@ __all__ = [
     "as_array",
     "contact_side",
     "drive_command",
+    "remove_files",
 ]
 
 #: stand-in for an unlimited force cap (engines want finite numbers)
 UNLIMITED_FORCE = 1.0e9
+
+
+def remove_files(paths: Sequence[str]) -> None:
+    """Delete the temporary files a body was built from (hull meshes the engine read); gone ones are fine."""
+    for f in paths:
+        try:
+            os.unlink(f)
+        except OSError:
+            pass
 
 
 def contact_side(a: BodyId, b: BodyId, body_a: BodyId | None, body_b: BodyId | None) -> bool | None:
@@ -221,11 +231,7 @@ class BodyRecord:
         return sel
 
     def delete_temp_files(self) -> None:
-        for f in self.temp_files:
-            try:
-                os.unlink(f)
-            except OSError:
-                pass
+        remove_files(self.temp_files)
         self.temp_files = []
 
 

@@ -31,7 +31,7 @@ import pybullet as pb
 
 from ..geometry import Pose
 from . import PYBULLET_CAPABILITIES
-from ._bodies import BodyRecord, BodyTable, as_array, contact_side, drive_command
+from ._bodies import BodyRecord, BodyTable, as_array, contact_side, drive_command, remove_files
 from ._urdf import BodyInertial, ground_ray_fixup, mass_properties, parse_urdf
 from .interface import (
     Backend,
@@ -510,59 +510,67 @@ class PyBulletBackend(Backend):
         mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
         tmp: list[str] = []
         hulls = {i: _convex_hull(s) for i, s in enumerate(shapes) if isinstance(s, MeshShape)}
-        arrays = self._shape_arrays(shapes, tmp, hulls)  # mesh hulls are written to disk once, here
-        if len(shapes) == 1:
-            col = pb.createCollisionShape(**self._shape_args(shapes[0], tmp), physicsClientId=cid)
-        elif all(isinstance(s, MeshShape) for s in shapes):  # convex pieces of a scanned object
-            col = self._mesh_compound(shapes, hulls, tmp)
-        elif len(shapes) > _MAX_COMPOUND_SHAPES:
-            raise BackendError(
-                f"{len(shapes)} collision shapes in one body: PyBullet keeps at most "
-                f"{_MAX_COMPOUND_SHAPES} of a mixed compound (convex meshes alone have no limit)"
+        try:  # a body that is not made leaves no hull file behind
+            arrays = self._shape_arrays(
+                shapes, tmp, hulls
+            )  # mesh hulls are written to disk once, here
+            if len(shapes) == 1:
+                col = pb.createCollisionShape(
+                    **self._shape_args(shapes[0], tmp), physicsClientId=cid
+                )
+            elif all(isinstance(s, MeshShape) for s in shapes):  # convex pieces of a scanned object
+                col = self._mesh_compound(shapes, hulls, tmp)
+            elif len(shapes) > _MAX_COMPOUND_SHAPES:
+                raise BackendError(
+                    f"{len(shapes)} collision shapes in one body: PyBullet keeps at most "
+                    f"{_MAX_COMPOUND_SHAPES} of a mixed compound (convex meshes alone have no limit)"
+                )
+            else:  # one single-link multibody; several shapes become one compound collision shape
+                col = self._compound(arrays)
+            texture = -1
+            if coloured:  # one textured mesh: createVisualShapeArray draws at most 16 shapes
+                vis, texture = self._coloured_visual(shapes + visuals)
+            else:
+                vis = self._visuals(arrays)
+            m = 0.0 if fixed else float(mass)
+            uid = pb.createMultiBody(
+                baseMass=m,
+                baseCollisionShapeIndex=col,
+                baseVisualShapeIndex=vis,
+                basePosition=pose.apply(mp.com).tolist(),
+                baseOrientation=(pose.rotation * mp.inertial_pose.rotation).as_quat().tolist(),
+                baseInertialFramePosition=mp.com.tolist(),
+                baseInertialFrameOrientation=mp.principal.tolist(),
+                physicsClientId=cid,
             )
-        else:  # one single-link multibody; several shapes become one compound collision shape
-            col = self._compound(arrays)
-        texture = -1
-        if coloured:  # one textured mesh: createVisualShapeArray draws at most 16 shapes
-            vis, texture = self._coloured_visual(shapes + visuals)
-        else:
-            vis = self._visuals(arrays)
-        m = 0.0 if fixed else float(mass)
-        uid = pb.createMultiBody(
-            baseMass=m,
-            baseCollisionShapeIndex=col,
-            baseVisualShapeIndex=vis,
-            basePosition=pose.apply(mp.com).tolist(),
-            baseOrientation=(pose.rotation * mp.inertial_pose.rotation).as_quat().tolist(),
-            baseInertialFramePosition=mp.com.tolist(),
-            baseInertialFrameOrientation=mp.principal.tolist(),
-            physicsClientId=cid,
-        )
-        # createMultiBody takes the base pose as the inertial frame's pose
-        pb.resetBasePositionAndOrientation(
-            uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
-        )
-        fr = self.config.default_friction if friction is None else friction
-        kw = {
-            "lateralFriction": fr,
-            "spinningFriction": self._spinning(fr),
-            "linearDamping": 0.0,
-            "angularDamping": 0.0,
-            "frictionAnchor": 1,
-        }
-        if not fixed:
-            kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
-        if any(isinstance(s, MeshShape) for s in shapes):
-            # Bullet grows a convex hull by its collision margin, 1 mm by default: the object was 1 mm
-            # fatter than its model (bench/bench_object_surfaces.py)
-            kw["collisionMargin"] = _MESH_MARGIN
-        pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
-        if vis >= 0 and texture >= 0:
-            pb.changeVisualShape(
-                uid, -1, textureUniqueId=texture, rgbaColor=[1, 1, 1, 1], physicsClientId=cid
+            # createMultiBody takes the base pose as the inertial frame's pose
+            pb.resetBasePositionAndOrientation(
+                uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
             )
-        elif vis >= 0:
-            pb.changeVisualShape(uid, -1, rgbaColor=list(_GREY), physicsClientId=cid)
+            fr = self.config.default_friction if friction is None else friction
+            kw = {
+                "lateralFriction": fr,
+                "spinningFriction": self._spinning(fr),
+                "linearDamping": 0.0,
+                "angularDamping": 0.0,
+                "frictionAnchor": 1,
+            }
+            if not fixed:
+                kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
+            if any(isinstance(s, MeshShape) for s in shapes):
+                # Bullet grows a convex hull by its collision margin, 1 mm by default: the object was 1 mm
+                # fatter than its model (bench/bench_object_surfaces.py)
+                kw["collisionMargin"] = _MESH_MARGIN
+            pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
+            if vis >= 0 and texture >= 0:
+                pb.changeVisualShape(
+                    uid, -1, textureUniqueId=texture, rgbaColor=[1, 1, 1, 1], physicsClientId=cid
+                )
+            elif vis >= 0:
+                pb.changeVisualShape(uid, -1, rgbaColor=list(_GREY), physicsClientId=cid)
+        except BaseException:
+            remove_files(tmp)
+            raise
         return self._register(
             _Body(
                 uid=uid,
@@ -728,8 +736,8 @@ class PyBulletBackend(Backend):
     def _hull_obj(hull: Any, tmp: list[str]) -> str:
         fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_hull_")
         os.close(fd)
-        hull.export(fn)
         tmp.append(fn)
+        hull.export(fn)
         return fn
 
     @staticmethod

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..geometry import Pose
 from . import SAPIEN_CAPABILITIES
-from ._bodies import BodyRecord, BodyTable, as_array, contact_side, drive_command
+from ._bodies import BodyRecord, BodyTable, as_array, contact_side, drive_command, remove_files
 from ._urdf import (
     BodyInertial,
     collision_only_copy,
@@ -334,43 +334,47 @@ class SapienBackend(Backend):
         mat = self._material(friction)
         builder = self._scene.create_actor_builder()
         tmp: list[str] = []
-        for s in shapes:
-            if isinstance(s, Box):
-                builder.add_box_collision(
-                    _sp(s.pose), [float(x) for x in s.half_extents], material=mat
-                )
-            elif isinstance(s, Sphere):
-                builder.add_sphere_collision(_sp(s.pose), float(s.radius), material=mat)
-            elif isinstance(s, Cylinder):
-                builder.add_cylinder_collision(
-                    _sp(s.pose * _X_TO_Z), float(s.radius), float(s.half_length), material=mat
-                )
-            elif isinstance(s, MeshShape):
-                for piece in _cookable_pieces(np.asarray(s.vertices, dtype=float)):
-                    fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_hull_")
-                    os.close(fd)
-                    piece.apply_scale(_COOK_UNITS)
-                    piece.export(fn)
-                    tmp.append(fn)
-                    builder.add_convex_collision_from_file(
-                        fn, _sp(s.pose), scale=(1.0 / _COOK_UNITS,) * 3, material=mat
+        try:  # a body that is not made leaves no hull file behind
+            for s in shapes:
+                if isinstance(s, Box):
+                    builder.add_box_collision(
+                        _sp(s.pose), [float(x) for x in s.half_extents], material=mat
                     )
+                elif isinstance(s, Sphere):
+                    builder.add_sphere_collision(_sp(s.pose), float(s.radius), material=mat)
+                elif isinstance(s, Cylinder):
+                    builder.add_cylinder_collision(
+                        _sp(s.pose * _X_TO_Z), float(s.radius), float(s.half_length), material=mat
+                    )
+                elif isinstance(s, MeshShape):
+                    for piece in _cookable_pieces(np.asarray(s.vertices, dtype=float)):
+                        fd, fn = tempfile.mkstemp(suffix=".obj", prefix="bh_hull_")
+                        os.close(fd)
+                        tmp.append(fn)
+                        piece.apply_scale(_COOK_UNITS)
+                        piece.export(fn)
+                        builder.add_convex_collision_from_file(
+                            fn, _sp(s.pose), scale=(1.0 / _COOK_UNITS,) * 3, material=mat
+                        )
+                else:
+                    raise BackendError(f"unknown shape {type(s).__name__}")
+            builder.set_initial_pose(_sp(pose))
+            h = self._new_handle()
+            nm = name or f"body{h}"
+            if fixed:
+                ent = builder.build_static(name=nm)
+                comp = ent.find_component_by_type(physx.PhysxRigidStaticComponent)
             else:
-                raise BackendError(f"unknown shape {type(s).__name__}")
-        builder.set_initial_pose(_sp(pose))
-        h = self._new_handle()
-        nm = name or f"body{h}"
-        if fixed:
-            ent = builder.build_static(name=nm)
-            comp = ent.find_component_by_type(physx.PhysxRigidStaticComponent)
-        else:
-            builder.set_mass_and_inertia(
-                float(mass), _sp(mp.inertial_pose), [float(x) for x in mp.inertia_diag]
-            )
-            ent = builder.build(name=nm)
-            comp = ent.find_component_by_type(physx.PhysxRigidDynamicComponent)
-            comp.linear_damping = 0.0  # no artificial damping (PhysX defaults to 0.05 angular)
-            comp.angular_damping = 0.0
+                builder.set_mass_and_inertia(
+                    float(mass), _sp(mp.inertial_pose), [float(x) for x in mp.inertia_diag]
+                )
+                ent = builder.build(name=nm)
+                comp = ent.find_component_by_type(physx.PhysxRigidDynamicComponent)
+                comp.linear_damping = 0.0  # no artificial damping (PhysX defaults to 0.05 angular)
+                comp.angular_damping = 0.0
+        except BaseException:
+            remove_files(tmp)
+            raise
         return self._register(
             _Body(handle=h, name=nm, entity=ent, component=comp, fixed=fixed, temp_files=tmp)
         )
