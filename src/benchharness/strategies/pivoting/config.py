@@ -61,7 +61,9 @@ class SetupConfig:
     The robot grasps the object where it rests on the table; the commanded
     grasp is off the task's by Gaussian set-up noise (``ctx.rng``):
     ``position_std`` (m, each axis of the hand frame; along the closing axis
-    it only decides which finger touches first), ``angle_std`` (deg, about
+    it puts the tool frame off the object's mid-plane, and since the fingers
+    are symmetric they close onto the mid-plane anyway: an object standing on
+    the table tilts, docs/pivoting.md "Symmetric fingers"), ``angle_std`` (deg, about
     the grasp axis). The set-up hand pose is then *measured*, and the runner
     discards the trial if it is more than 10 % off (paper II-B).
     ``approach_clearance`` (m): the pre-grasp stand-off along the approach.
