@@ -7,7 +7,9 @@ summed normal force of each pad on the object, and the table's support: its summ
 and the centre of pressure's distance inside the support polygon's nearest edge (mm; the object
 tips when it reaches 0). Also prints, for each primitive, the largest tilt it caused.
 
-    python bench/trace_table_rig.py --backend pybullet --trial 1 --strategy-option model=ycb
+    python bench/trace_table_rig.py --backend pybullet --trial 1          # on the YCB scan (the default)
+    python bench/trace_table_rig.py --trial 13 --repeats 5 --strategy-option model=generated \
+        --exec setup.position_std=0                                         # no set-up position noise
     python bench/trace_table_rig.py --task inhand-level1-pivoting --strategy pivoting --trial 7
 """
 
@@ -103,7 +105,7 @@ def main() -> None:
             return
         st["next"] = t + args.every
         pose = be.get_pose(rig.body)
-        rest = st.setdefault("rest", pose)
+        rest = st["rest"]  # the engine's pose when the rig built the scene
         turn = (pose.rotation * rest.rotation.inv()).as_rotvec()
         tilt = math.degrees(float(np.linalg.norm(turn)))
         try:  # the turn's axis in the hand frame (x approach, z closing), and the hand in the object

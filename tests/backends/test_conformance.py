@@ -539,9 +539,8 @@ def test_attach_detach(backend: Backend):
 
 
 def _coupling_or_skip(backend: Backend) -> None:
-    if (
-        not backend.capabilities.joint_coupling
-    ):  # an optional capability: such a backend must refuse
+    # an optional capability: a backend without it must refuse
+    if not backend.capabilities.joint_coupling:
         grip = backend.load_urdf(GRIPPER_URDF, Pose())
         with pytest.raises(CapabilityError):
             backend.couple_joints(grip, "right_finger", "left_finger")
@@ -570,6 +569,16 @@ def test_couple_joints_drives_the_follower(backend: Backend, multiplier: float):
     assert q[2] == pytest.approx(multiplier * q[1], abs=2e-4)
     backend.remove_body(grip)  # the coupling goes with its body
     backend.step(1)
+
+
+def test_couple_joints_refuses_what_it_cannot_tie(backend: Backend):
+    """An unknown joint and a zero multiplier are errors, on every engine alike."""
+    _coupling_or_skip(backend)
+    grip = backend.load_urdf(GRIPPER_URDF, Pose())
+    with pytest.raises(BackendError, match="no movable joint 'thumb'"):
+        backend.couple_joints(grip, "thumb", "left_finger")
+    with pytest.raises(BackendError, match="non-zero multiplier"):
+        backend.couple_joints(grip, "right_finger", "left_finger", 0.0)
 
 
 @pytest.mark.parametrize("coupled", [True, False], ids=["coupled", "independent"])

@@ -80,9 +80,35 @@ def test_pybullet_keeps_every_convex_piece_of_a_scan():
     assert hits.hit.all(), np.flatnonzero(~hits.hit)
 
 
+def test_a_body_the_engine_refuses_leaves_no_hull_file(tmp_path, monkeypatch):
+    """A mesh body whose creation fails after its hull was written to disk removes that file."""
+    import tempfile
+
+    import pybullet
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    be = get_manager().create("backend", "pybullet")
+    cube = MeshShape(
+        vertices=np.array([[x, y, z] for x in (0, 0.01) for y in (0, 0.01) for z in (0, 0.01)]),
+        faces=np.zeros((0, 3), dtype=int),
+    )
+
+    def refuse(*args, **kwargs):
+        assert list(tmp_path.glob("bh_hull_*")), "the hull is written before the body is made"
+        raise pybullet.error("refused")
+
+    monkeypatch.setattr(pybullet, "createMultiBody", refuse)
+    try:
+        with pytest.raises(pybullet.error, match="refused"):
+            be.add_body([cube], Pose(), 0.1)
+        assert not [p.name for p in tmp_path.glob("bh_hull_*")]
+    finally:
+        be.close()
+
+
 def test_pybullet_refuses_a_mixed_compound_it_would_truncate(tmp_path, monkeypatch):
-    """Refused with a clear error, and the hull file already written for its mesh is gone too
-    (it was left in the temporary directory, one per test-suite run, until 2026-12-05)."""
+    """Refused with a clear error before any hull file is written (until 2026-12-05 its mesh's hull
+    was written first and left in the temporary directory, one per test-suite run)."""
     import tempfile
 
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))

@@ -94,10 +94,11 @@ def test_stage_puts_the_tool_where_commanded(backend):
 def test_vertical_fingers_press_equally_on_what_they_hold(backend, force):
     """Fingers closing vertically on a fixed block press it with the force asked for, both alike.
 
-    The real gripper's fingers share one motor through the mimic linkage, so their weights (2.1 N each)
-    cancel; independent finger drives (``symmetric=False``, the model before the coupling) carry their own weight
-    (``gravity_compensated``) and close together at the published gap speed (``close_speed``). Without that, the upper pad pressed twice a finger's weight
-    harder than the lower one: a net push on a cube held by the other hand.
+    The real gripper's fingers share one motor through the mimic linkage, so their weights (2.1 N
+    each) cancel; independent finger drives (``symmetric=False``, the model before the coupling)
+    carry their own weight (``gravity_compensated``) and close together at the published gap speed
+    (``close_speed``). Without that, the upper pad pressed twice a finger's weight harder than the
+    lower one: a net push on a cube held by the other hand.
     """
     from dataclasses import replace
 

@@ -230,6 +230,18 @@ class BodyRecord:
             sel = self._sel[key] = np.asarray(self.joint_indices(joints), dtype=int)
         return sel
 
+    def coupled_joints(self, follower: str, leader: str, multiplier: float) -> tuple[int, int]:
+        """The two joints of a :meth:`~.interface.Backend.couple_joints`, checked the same on every
+        engine (one-axis joints of this body, a non-zero multiplier): their indices into
+        :attr:`joints`, follower first."""
+        fi, li = self.joint_indices([follower, leader])
+        for i in (fi, li):
+            if self.joints[i].type not in ("prismatic", "revolute", "continuous"):
+                raise BackendError(f"joint {self.joints[i].name!r} is not a one-axis joint")
+        if float(multiplier) == 0.0:
+            raise BackendError("a joint coupling needs a non-zero multiplier")
+        return fi, li
+
     def delete_temp_files(self) -> None:
         remove_files(self.temp_files)
         self.temp_files = []

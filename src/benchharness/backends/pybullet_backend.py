@@ -508,23 +508,22 @@ class PyBulletBackend(Backend):
         # drawn geometry only where something may be filmed (set_visuals): it never changes physics
         coloured = self.draws_visuals and (bool(visuals) or any(s.rgba is not None for s in shapes))
         mp: BodyInertial = mass_properties(shapes, mass if mass > 0 else 1.0, com, inertia_diag)
+        if len(shapes) > _MAX_COMPOUND_SHAPES and not all(isinstance(s, MeshShape) for s in shapes):
+            raise BackendError(
+                f"{len(shapes)} collision shapes in one body: PyBullet keeps at most "
+                f"{_MAX_COMPOUND_SHAPES} of a mixed compound (convex meshes alone have no limit)"
+            )
         tmp: list[str] = []
         hulls = {i: _convex_hull(s) for i, s in enumerate(shapes) if isinstance(s, MeshShape)}
-        try:  # a body that is not made leaves no hull file behind
-            arrays = self._shape_arrays(
-                shapes, tmp, hulls
-            )  # mesh hulls are written to disk once, here
+        try:  # a body the engine does not make leaves no hull file behind
+            # mesh hulls are written to disk once, here
+            arrays = self._shape_arrays(shapes, tmp, hulls)
             if len(shapes) == 1:
                 col = pb.createCollisionShape(
                     **self._shape_args(shapes[0], tmp), physicsClientId=cid
                 )
             elif all(isinstance(s, MeshShape) for s in shapes):  # convex pieces of a scanned object
                 col = self._mesh_compound(shapes, hulls, tmp)
-            elif len(shapes) > _MAX_COMPOUND_SHAPES:
-                raise BackendError(
-                    f"{len(shapes)} collision shapes in one body: PyBullet keeps at most "
-                    f"{_MAX_COMPOUND_SHAPES} of a mixed compound (convex meshes alone have no limit)"
-                )
             else:  # one single-link multibody; several shapes become one compound collision shape
                 col = self._compound(arrays)
             texture = -1
@@ -543,34 +542,34 @@ class PyBulletBackend(Backend):
                 baseInertialFrameOrientation=mp.principal.tolist(),
                 physicsClientId=cid,
             )
-            # createMultiBody takes the base pose as the inertial frame's pose
-            pb.resetBasePositionAndOrientation(
-                uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
-            )
-            fr = self.config.default_friction if friction is None else friction
-            kw = {
-                "lateralFriction": fr,
-                "spinningFriction": self._spinning(fr),
-                "linearDamping": 0.0,
-                "angularDamping": 0.0,
-                "frictionAnchor": 1,
-            }
-            if not fixed:
-                kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
-            if any(isinstance(s, MeshShape) for s in shapes):
-                # Bullet grows a convex hull by its collision margin, 1 mm by default: the object was 1 mm
-                # fatter than its model (bench/bench_object_surfaces.py)
-                kw["collisionMargin"] = _MESH_MARGIN
-            pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
-            if vis >= 0 and texture >= 0:
-                pb.changeVisualShape(
-                    uid, -1, textureUniqueId=texture, rgbaColor=[1, 1, 1, 1], physicsClientId=cid
-                )
-            elif vis >= 0:
-                pb.changeVisualShape(uid, -1, rgbaColor=list(_GREY), physicsClientId=cid)
         except BaseException:
             remove_files(tmp)
             raise
+        # createMultiBody takes the base pose as the inertial frame's pose
+        pb.resetBasePositionAndOrientation(
+            uid, *self._com_pose_of(pose, mp.inertial_pose), physicsClientId=cid
+        )
+        fr = self.config.default_friction if friction is None else friction
+        kw = {
+            "lateralFriction": fr,
+            "spinningFriction": self._spinning(fr),
+            "linearDamping": 0.0,
+            "angularDamping": 0.0,
+            "frictionAnchor": 1,
+        }
+        if not fixed:
+            kw["localInertiaDiagonal"] = mp.inertia_diag.tolist()
+        if any(isinstance(s, MeshShape) for s in shapes):
+            # Bullet grows a convex hull by its collision margin, 1 mm by default: the object was 1 mm
+            # fatter than its model (bench/bench_object_surfaces.py)
+            kw["collisionMargin"] = _MESH_MARGIN
+        pb.changeDynamics(uid, -1, **kw, physicsClientId=cid)
+        if vis >= 0 and texture >= 0:
+            pb.changeVisualShape(
+                uid, -1, textureUniqueId=texture, rgbaColor=[1, 1, 1, 1], physicsClientId=cid
+            )
+        elif vis >= 0:
+            pb.changeVisualShape(uid, -1, rgbaColor=list(_GREY), physicsClientId=cid)
         return self._register(
             _Body(
                 uid=uid,
@@ -1135,12 +1134,7 @@ class PyBulletBackend(Backend):
         ``q_follower = multiplier * q_leader``.
         """
         b = self._b(body)
-        fi, li = b.joint_indices([follower, leader])
-        for i in (fi, li):
-            if b.joints[i].type not in ("prismatic", "revolute", "continuous"):
-                raise BackendError(f"joint {b.joints[i].name!r} is not a one-axis joint")
-        if float(multiplier) == 0.0:
-            raise BackendError("a joint coupling needs a non-zero multiplier")
+        fi, li = b.coupled_joints(follower, leader, multiplier)
         cid = pb.createConstraint(
             b.uid,
             b.joint_index[fi],

@@ -866,18 +866,13 @@ class SapienBackend(Backend):
         stiff coupling stays stable). The two joints must hang from one link.
         """
         b = self._b(body)
-        fi, li = b.joint_indices([follower, leader])
+        fi, li = b.coupled_joints(follower, leader, multiplier)
         jf, jl = b.joints[fi], b.joints[li]
-        for j in (jf, jl):
-            if j.type not in ("prismatic", "revolute", "continuous"):
-                raise BackendError(f"joint {j.name!r} is not a one-axis joint")
         if b.articulation is None or jf.parent_link != jl.parent_link:
             raise BackendError(
                 f"cannot couple {follower!r} to {leader!r}: the joints must share a parent link"
             )
         m = float(multiplier)
-        if m == 0.0:
-            raise BackendError("a joint coupling needs a non-zero multiplier")
         b.articulation.create_fixed_tendon(
             [b.links[jl.parent_link], b.links[jl.child_link], b.links[jf.child_link]],
             [0.0, m, -1.0],

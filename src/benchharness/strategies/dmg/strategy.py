@@ -4,9 +4,9 @@ Task files give grasps in the published (real-YCB) frames; by default the
 planner plans on the YCB scan, already in those frames (``DMGSurface``); with
 ``DMGSurface(model="generated")`` it moves them onto our generated meshes with
 :mod:`.placement`, plans there, and maps the final grasp back, so results files
-line up with the task file either way. For the contact metrics our mesh is exported in the published frame
-next to the results file and the desired region is written as its vertex
-indices.
+line up with the task file either way. For the contact metrics our mesh is
+exported in the published frame next to the results file and the desired
+region is written as its vertex indices.
 """
 
 from __future__ import annotations
