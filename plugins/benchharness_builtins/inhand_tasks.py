@@ -28,7 +28,11 @@ TASK_SETS = {
     ),
     "inhand-level1-pivoting": (
         "level1_pivoting.csv",
-        "In-hand Level I for a parallel gripper: published re-orientations as pivots about the grasp axis",
+        "In-hand Level I for a parallel gripper: published re-orientations as pivots about the grasp axis (YCB scans)",
+    ),
+    "inhand-level1-pivoting-generated": (
+        "level1_pivoting_generated.csv",
+        "In-hand Level I pivots on the shapes generated from the published dimensions",
     ),
     "inhand-level2-dmg-regions": (
         "level2_dmg_regions.csv",

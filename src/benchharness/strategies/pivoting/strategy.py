@@ -89,21 +89,27 @@ class PivotingStrategy:
 
     def run_trial(self, ctx: TrialContext) -> TrialOutcome:
         from ...objects import load_object
-        from .tasks import PIVOT_OBJECTS, rest_pose
+        from .tasks import grasp_axis, rest_pose
 
         item = ctx.item
         if getattr(item, "benchmark", None) != "inhand":
             raise ValueError("the pivoting strategy runs in-hand tasks")
-        axis_text = (item.extra or {}).get("grasp_axis")
-        if not axis_text:
-            keys = {" ".join(k.lower().split()): v for k, v in PIVOT_OBJECTS.items()}
-            axis = keys.get(" ".join(str(item.object).lower().split()))
-            if axis is None:
-                raise ValueError(
-                    f"task {item.task_id!r}: no grasp_axis column and no default grasp axis for {item.object!r}"
-                )
-        else:
+        extra = item.extra or {}
+        # a task's hand poses are in the frame of the model it was derived on; a file without
+        # the column predates the scans and was derived on the generated shapes
+        kind = str(extra.get("model") or "generated")
+        if kind not in ("ycb", "generated"):
+            raise ValueError(
+                f"task {item.task_id!r}: model must be 'ycb' or 'generated', not {kind!r}"
+            )
+        axis_text = extra.get("grasp_axis")
+        if axis_text:
             axis = tuple(float(v) for v in str(axis_text).split())
+        else:
+            try:
+                axis = tuple(grasp_axis(str(item.object), kind))
+            except ValueError as e:
+                raise ValueError(f"task {item.task_id!r}: no grasp_axis column and {e}") from None
         if getattr(ctx.robot, "name", "") != "pr2-gripper":
             raise ValueError(
                 f"the pivoting strategy drives the pr2-gripper robot, got {getattr(ctx.robot, 'name', ctx.robot)!r}"
@@ -111,8 +117,11 @@ class PivotingStrategy:
         cfg = self.config
         ex = cfg.execution
         t0 = time.perf_counter()
-        model = load_object(item.object, resolution=ex.resolution)
-        rest_text = (item.extra or {}).get("rest_pose")
+        model = load_object(
+            item.object,
+            **({"resolution": ex.resolution} if kind == "generated" else {"model": "ycb"}),
+        )
+        rest_text = extra.get("rest_pose")
         rest = (
             Pose.from_array([float(v) for v in str(rest_text).split()])
             if rest_text
@@ -120,6 +129,7 @@ class PivotingStrategy:
                 item.object,
                 axis,
                 grasp_axis_angle(Pose.from_array(item.initial), Pose.from_array(item.desired))[0],
+                kind,
             )
         )
         initial = Pose.from_array(item.initial)
