@@ -264,11 +264,12 @@ def _from_mesh(spec: ObjectSpec, path: Path, collision: CollisionMode) -> Object
 
 @functools.lru_cache(maxsize=16)
 def _scanned(name: str) -> ObjectModel:
-    from .ycb import read_parts, read_scan, scan_offset
+    from .ycb import drop_stray_pieces, read_parts, read_scan, scan_offset
 
     spec = get_spec(name)
     offset = scan_offset(spec.scan.file, spec.scan.frame)
     surface = read_scan(spec.scan.file)
+    drop_stray_pieces(surface)  # the gelatin box's and tuna can's four stray slivers each
     surface.apply_translation(offset)
     surface.metadata["name"] = spec.name
     if spec.scan.collision == "hull":
@@ -276,8 +277,8 @@ def _scanned(name: str) -> ObjectModel:
     else:
         pieces = [(v + offset, f) for v, f in read_parts(spec.scan.file)]
     shapes: list[Shape] = [MeshShape(vertices=v, faces=f) for v, f in pieces]
-    # the scan's own solid where it is closed (10 of 12); the gelatin box's
-    # and tuna can's scans have holes, so their hull (one piece) carries the mass
+    # the scan's own solid (all twelve are closed once the strays are dropped); a surface that
+    # is not (a future scan) spreads the mass over its collision pieces instead
     closed = surface.is_watertight and surface.volume > 0
     return ObjectModel(
         spec=spec,
