@@ -208,6 +208,10 @@ def test_scan_pivot_tasks_grip_the_scan_across_its_flat_faces():
     assert list(grasp_axis("Lego Duplo", "generated")) == [0.0, 1.0, 0.0]
     with pytest.raises(ValueError, match="not a pivoting object"):
         grasp_axis("apple")
+    with pytest.raises(
+        ValueError, match="cannot be pivoted on its 'ycb' model: the YCB scan's ends"
+    ):
+        grasp_axis("Lego Duplo", "ycb")
 
 
 def test_pivot_angle_and_grasp_geometry():

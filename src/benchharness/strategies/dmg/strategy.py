@@ -116,10 +116,7 @@ class DMGPlanner:
         named = {_key(k): v for k, v in self.meshes.items()}
         if _key(obj) in named:
             return named[_key(obj)]
-        surface = self.object_model(obj).surface
-        if self.surface.model == "ycb":
-            surface.update_faces(surface.nondegenerate_faces())  # a copy: the model is cached
-        return surface
+        return self.object_model(obj).surface
 
     def object_model(self, obj: str):
         """The :class:`~benchharness.objects.ObjectModel` of :attr:`surface` (the simulated body too)."""

@@ -89,7 +89,7 @@ class PivotingStrategy:
 
     def run_trial(self, ctx: TrialContext) -> TrialOutcome:
         from ...objects import load_object
-        from .tasks import grasp_axis, rest_pose
+        from .tasks import PIVOT_TASK_FILES, grasp_axis, rest_pose
 
         item = ctx.item
         if getattr(item, "benchmark", None) != "inhand":
@@ -98,7 +98,7 @@ class PivotingStrategy:
         # a task's hand poses are in the frame of the model it was derived on; a file without
         # the column predates the scans and was derived on the generated shapes
         kind = str(extra.get("model") or "generated")
-        if kind not in ("ycb", "generated"):
+        if kind not in PIVOT_TASK_FILES:
             raise ValueError(
                 f"task {item.task_id!r}: model must be 'ycb' or 'generated', not {kind!r}"
             )

@@ -112,9 +112,14 @@ def _model(obj: str, model: str):
     return load_object(obj, model=model)
 
 
-def _key(obj: str) -> str:
+def _find(obj: str) -> str | None:
+    """The ``PIVOT_OBJECTS`` key of ``obj`` (any case and spacing), or None."""
     keys = {" ".join(k.lower().split()): k for k in PIVOT_OBJECTS}
-    k = keys.get(" ".join(str(obj).lower().split()))
+    return keys.get(" ".join(str(obj).lower().split()))
+
+
+def _key(obj: str) -> str:
+    k = _find(obj)
     if k is None:
         raise ValueError(f"{obj!r} is not a pivoting object (use one of {sorted(PIVOT_OBJECTS)})")
     return k
@@ -127,10 +132,13 @@ def _box(obj: str, model: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
     object's extremes along the grasp axis (where symmetric fingers centre it)."""
     import trimesh
 
+    spec = PIVOT_OBJECTS[_key(obj)]
+    if model not in spec.models:
+        raise ValueError(f"{obj!r} cannot be pivoted on its {model!r} model: {spec.why_not}")
     surface = _model(obj, model).surface
     to_box, extents = trimesh.bounds.oriented_bounds(surface)
     box = np.linalg.inv(to_box)
-    axis = box[:3, int(np.argsort(extents)[PIVOT_OBJECTS[_key(obj)].axis_rank])]
+    axis = box[:3, int(np.argsort(extents)[spec.axis_rank])]
     n, area = np.asarray(surface.face_normals), np.asarray(surface.area_faces)
     sides = n @ axis
     flat = np.abs(sides) > math.cos(math.radians(FLAT_FACE_DEG))
@@ -217,11 +225,10 @@ def derive_pivot_tasks(level1_path: str | Path | None = None, model: str = "ycb"
     src = read_tasks(
         Path(level1_path) if level1_path else tasks_dir() / "inhand" / "level1_hand_poses.csv"
     )
-    keys = {" ".join(k.lower().split()): k for k in PIVOT_OBJECTS}
     rows = []
     for i in range(len(src)):
         obj = str(src.object[i])
-        k = keys.get(" ".join(obj.lower().split()))
+        k = _find(obj)
         if k is None or model not in PIVOT_OBJECTS[k].models or int(src.level[i]) != 1:
             continue
         pivot = pivot_angle(src.initial[i, 3:], src.desired[i, 3:])
