@@ -36,10 +36,12 @@ def make_planner(**kwargs):
 def _options():
     """``--strategy-option`` defaults: the object model (:class:`.config.DMGSurface`; the YCB
     scans), e.g. ``--strategy-option model=generated`` to plan, simulate and score on the shapes
-    generated from the published dimensions."""
+    generated from the published dimensions; and the execution
+    (:class:`.execution.DMGExecConfig`), e.g. ``execution.support=table``."""
     from .config import DMGSurface
+    from .execution import DMGExecConfig
 
-    return {"surface": DMGSurface()}
+    return {"surface": DMGSurface(), "execution": DMGExecConfig()}
 
 
 REGISTRATIONS = [

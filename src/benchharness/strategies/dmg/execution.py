@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -64,6 +65,13 @@ class DMGExecConfig:
     (:meth:`~benchharness.strategies.pivoting.rig.TableRig.servo`). ``require_goal``: fail as
     ``unreachable`` when the planner could not connect the goal (False: the
     best-effort plan is executed and scored, as the planner's own results).
+    ``support``: what holds the object while the grasp changes: ``"table"``
+    (it rests on the table in a stable pose that keeps the grasp axis
+    horizontal; no such pose: ``unreachable``), ``"fixture"`` (an ideal clamp
+    holds it ``fixture_height`` m above the table in its most probable stable
+    pose, opened before the final lift; :meth:`TableRig.build
+    <benchharness.strategies.pivoting.rig.TableRig.build>`), ``"auto"`` (the
+    default: the table where a rest pose serves, else the fixture).
     """
 
     execution: ExecutionConfig = field(default_factory=ExecutionConfig)
@@ -73,6 +81,14 @@ class DMGExecConfig:
     corrections: int = 2
     correction_position: float = 0.001
     correction_angle: float = 1.0
+    support: Literal["auto", "table", "fixture"] = "auto"
+    fixture_height: float = 0.2
+
+    def __post_init__(self) -> None:
+        if self.support not in ("auto", "table", "fixture"):
+            raise ValueError(f"support must be 'auto', 'table' or 'fixture', got {self.support!r}")
+        if not (math.isfinite(self.fixture_height) and self.fixture_height > 0):
+            raise ValueError(f"fixture_height must be > 0 m, got {self.fixture_height!r}")
 
 
 @dataclass(frozen=True)
@@ -190,23 +206,43 @@ def plan_to_region(dmg, initial, desired_contacts: np.ndarray):
     )
 
 
-def choose_rest(model, poses: list[Pose], width: float, cfg: ExecutionConfig) -> tuple[Pose, float]:
-    """The stable rest pose (grasp axis horizontal) with the most gripper clearance over ``poses``.
+def choose_rest(
+    model,
+    poses: list[Pose],
+    width: float,
+    cfg: ExecutionConfig,
+    fixture_height: float | None = None,
+) -> tuple[Pose, float]:
+    """Where the object lies while the grasp changes, and the gripper's worst clearance there.
 
+    On the table (``fixture_height`` None): the stable rest pose that keeps
+    the grasp axis horizontal with the most gripper clearance over ``poses``.
+    In a fixture ``fixture_height`` m above the table: the most probable
+    stable pose, whatever the grasp axis, whose clearance is at least
+    ``cfg.motion.min_clearance`` (else the one with the most).
     ``poses`` are hand poses in the object frame (set-up, pre-grasp and the
-    plan); returns (rest pose, its worst clearance in m).
+    plan); returns (rest pose on a table at z = 0, its worst clearance in m).
     """
     from ..pivoting.rig import clearance, stable_rest_poses
 
     axis = poses[0].rotation.apply([0.0, 0.0, 1.0])
-    rests = stable_rest_poses(model.surface, model.mass.com, axis)
+    fixture = fixture_height is not None
+    # in a fixture any stable pose serves: the grasp axis may point anywhere
+    rests = stable_rest_poses(
+        model.surface, model.mass.com, axis, **({"max_tilt_deg": 90.0} if fixture else {})
+    )
     if not rests:
         return None, -np.inf
     opening = width + 0.03
+    floor = cfg.motion.table_height - (fixture_height or 0.0)
     scored = [
-        (min(clearance(r * h, opening, cfg.motion.table_height, width) for h in poses), i, r)
+        (min(clearance(r * h, opening, floor, width) for h in poses), i, r)
         for i, r in enumerate(rests)
     ]
+    if fixture:
+        for c, _, rest in scored:
+            if c >= cfg.motion.min_clearance:
+                return rest, c
     c, _, rest = max(scored, key=lambda t: (t[0], -t[1]))
     return rest, c
 
@@ -293,7 +329,16 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
         setup_pose.p - setup_pose.rotation.apply([ex.setup.approach_clearance, 0.0, 0.0]),
         setup_pose.q,
     )
-    rest, worst = choose_rest(model, [setup_pose, pre] + [w.pose for w in waypoints], width, ex)
+    hand_poses = [setup_pose, pre] + [w.pose for w in waypoints]
+    fixture = None
+    rest, worst = None, -np.inf
+    if cfg.support != "fixture":
+        rest, worst = choose_rest(model, hand_poses, width, ex)
+    on_table = rest is not None and worst >= ex.motion.min_clearance
+    if cfg.support == "fixture" or (cfg.support == "auto" and not on_table):
+        fixture = cfg.fixture_height
+        rest, worst = choose_rest(model, hand_poses, width, ex, fixture)
+    info["support"] = "table" if fixture is None else "fixture"
     info["rest_clearance_mm"] = None if rest is None else worst * 1e3
     if rest is None or worst < ex.motion.min_clearance:
         why = (
@@ -303,13 +348,13 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
         )
         return TrialOutcome(
             failure="unreachable",
-            message=f"cannot execute on the table: {why}",
+            message=f"cannot execute {'in the fixture' if fixture else 'on the table'}: {why}",
             plan_time_s=plan.plan_time_s,
             extra=info,
         )
     info["rest_pose"] = rest.as_array().tolist()
     rig = TableRig(ctx.backend, ctx.robot, model, ex, ctx.rng)
-    rig.build(rest)
+    rig.build(rest, fixture_height=fixture)
     try:
         setup = rig.setup_grasp(setup_pose, width)
         t_exec = ctx.backend.time

@@ -12,7 +12,8 @@ the tool centre point). Primitives, all through the Backend interface:
   object frame (quintic timing, pose interpolation, stage joints every
   control tick);
 * :meth:`TableRig.lift_and_hold` -- the paper's final check: lift off the
-  table, hold 5 s without support, report stability and drops.
+  table (or out of the fixture, :meth:`TableRig.build`), hold 5 s without
+  support, report stability and drops.
 
 Why the object rests on the table while the grasp changes: with a light
 squeeze, the table holds the object (friction and its weight against
@@ -38,7 +39,14 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from ...geometry import Pose
-from ...robots.descriptions.pr2 import FINGER_TRAVEL, PAD_GAP, TCP_X, finger_boxes, pad_setback
+from ...robots.descriptions.pr2 import (
+    FINGER_TRAVEL,
+    PAD_GAP,
+    PAD_SIZE,
+    TCP_X,
+    finger_boxes,
+    pad_setback,
+)
 from .config import ExecutionConfig
 
 __all__ = [
@@ -47,6 +55,7 @@ __all__ = [
     "TableRig",
     "RigFailure",
     "gripper_boxes",
+    "centre_between_pads",
     "clearance",
     "stable_rest_poses",
     "HoldResult",
@@ -65,6 +74,30 @@ def hand_in_tcp(width: float) -> Pose:
     on the grasp the task gives (the fingertip contacts' midpoint).
     """
     return Pose.from_rotation(np.array([-pad_setback(width), 0.0, 0.0]), HAND_IN_TCP)
+
+
+def centre_between_pads(hand_in_object: Pose, vertices: np.ndarray) -> Pose:
+    """``hand_in_object`` moved along its closing axis (z) to midway between where its pads meet the object.
+
+    Each pad's face (``PAD_SIZE``: 36 mm along x, 23 mm along y, centred on
+    the hand origin) stops at the object's outermost surface point under it
+    along z, the vertices' extremes within the footprint (exact to a vertex
+    spacing). Why: the PR2's two fingers close symmetrically about the tool
+    centre point (the published mimic), so an object held in a fixture,
+    which cannot slide between the pads as one on the table does, is gripped
+    by both pads only if the hand is centred on it where the pads land: on a
+    blade that thickens across the pad (the spatula's, 20 deg) that is up to
+    a few millimetres from the midpoint of the two contacts on the closing
+    line. The closing line stays the same, so the contacts the task scores do
+    not move. Unchanged if no vertex lies under the pads.
+    """
+    loc = hand_in_object.inv().apply(np.asarray(vertices, float))
+    under = (np.abs(loc[:, 0]) <= PAD_SIZE[0] / 2) & (np.abs(loc[:, 1]) <= PAD_SIZE[2] / 2)
+    if not under.any():
+        return hand_in_object
+    z = loc[under, 2]
+    shift = 0.5 * (float(z.min()) + float(z.max()))
+    return hand_in_object * Pose(np.array([0.0, 0.0, shift]), np.array([0.0, 0.0, 0.0, 1.0]))
 
 
 class RigFailure(Exception):
@@ -175,7 +208,7 @@ class HoldResult:
 
 @dataclass
 class TableRig:
-    """One trial's scene: backend, ``pr2-gripper`` robot, object resting on the table."""
+    """One trial's scene: backend, ``pr2-gripper`` robot, object resting on the table (or in a fixture)."""
 
     backend: object
     robot: object
@@ -187,6 +220,8 @@ class TableRig:
     #: width (m) of the object between the pads, which places the hand frame (:func:`hand_in_tcp`);
     #: set by :meth:`setup_grasp`
     grip_width: float | None = None
+    #: the fixture's constraint handle while one holds the object (:meth:`build`), else None
+    fixture: int | None = None
 
     @property
     def _width(self) -> float:
@@ -199,17 +234,34 @@ class TableRig:
         return hand_in_tcp(self._width)
 
     # ------------------------------------------------------------------ scene
-    def build(self, rest: Pose) -> None:
-        """Table (ground plane) and the object at ``rest``, settled."""
+    def build(self, rest: Pose, *, fixture_height: float | None = None) -> None:
+        """Table (ground plane) and the object at ``rest`` (a pose on a table at z = 0).
+
+        ``fixture_height`` (m): instead of resting on the table, the object is
+        held that much higher by a **fixture** -- an ideal clamp, a fixed
+        constraint between the object and the table with no geometry of its
+        own -- until :meth:`release_support` (the final lift). Why: a grasp
+        whose axis no stable rest pose keeps horizontal (the spatula's, across
+        its flat blade) cannot be changed with the object lying on the table,
+        and the paper names "a fixture or a surface present in the
+        environment" among what a parallel gripper pushes against (docs/dmg.md,
+        "Fixture").
+        """
         b, g = self.backend, self.config.grip
-        b.add_ground(self.config.motion.table_height, friction=g.table_friction)
+        ground = b.add_ground(self.config.motion.table_height, friction=g.table_friction)
         kw = self.model.body_kwargs()
+        lift = 0.0 if fixture_height is None else float(fixture_height)
         self.body = b.add_body(
-            pose=Pose(rest.p + [0, 0, self.config.motion.table_height], rest.q),
+            pose=Pose(rest.p + [0, 0, self.config.motion.table_height + lift], rest.q),
             friction=g.object_friction,
             **kw,
         )
         self.rest = self.backend.get_pose(self.body)
+        self.fixture = None
+        if fixture_height is not None:
+            self.fixture = b.attach(
+                ground, None, self.body, None, b.get_pose(ground).inv() * self.rest
+            )
         self.mass = float(kw["mass"])
         self.weight = self.mass * abs(float(b.config.gravity[2]))
         self.arm = self.robot.arm("stage")
@@ -293,6 +345,24 @@ class TableRig:
         self.gripper.set_command([half], force_limit=self.config.grip.hold_force)
         self.robot.settle(wait)
 
+    def _centred(self, hand_in_object: Pose) -> Pose:
+        """A hand target, centred between the pads' landings if a fixture holds the object.
+
+        On the table the squeezed object slides until both pads press on it; in
+        the fixture it cannot, so the hand moves instead (:func:`centre_between_pads`):
+        the set-up noise along the closing axis and a blade thickening across the
+        pads are taken up by the hand, as an arm grasping a clamped part does.
+        """
+        if self.fixture is None:
+            return hand_in_object
+        return centre_between_pads(hand_in_object, self.model.surface.vertices)
+
+    def release_support(self) -> None:
+        """Open the fixture, if the object is held by one (:meth:`build`); the table stays."""
+        if self.fixture is not None:
+            self.backend.detach(self.fixture)
+            self.fixture = None
+
     def loosen(self) -> None:
         self.set_grip(self.config.grip.loose_force(self.mass))
 
@@ -318,7 +388,7 @@ class TableRig:
         from ...robots.pr2_gripper import stage_joints_for
 
         obj = self.object_pose() if object_pose is None else object_pose
-        targets = [self.hand_world()] + [obj * h for h in hand_in_object]
+        targets = [self.hand_world()] + [obj * self._centred(h) for h in hand_in_object]
         m = self.config.motion
         for t in targets[1:]:
             c = clearance(t, self.opening(), m.table_height, self._width)
@@ -400,6 +470,7 @@ class TableRig:
         primitive falls short; the tracker sees it, as a camera would.
         """
         log = []
+        target = self._centred(target)  # where :meth:`follow` puts the hand (idempotent)
         for k in range(max_tries + 1):
             now = self.hand_in_object()
             dp = float(np.linalg.norm(now.p - target.p))
@@ -472,7 +543,9 @@ class TableRig:
         s = self.config.setup
         dp = self.rng.normal(0.0, s.position_std, 3) if s.position_std > 0 else np.zeros(3)
         da = self.rng.normal(0.0, math.radians(s.angle_std)) if s.angle_std > 0 else 0.0
-        noisy = hand_in_object * Pose.from_rotation(dp, Rotation.from_rotvec([0.0, 0.0, da]))
+        noisy = self._centred(
+            hand_in_object * Pose.from_rotation(dp, Rotation.from_rotvec([0.0, 0.0, da]))
+        )
         obj = self.object_pose()
         target = obj * noisy
         pre = Pose(target.p - target.rotation.apply([s.approach_clearance, 0.0, 0.0]), target.q)
@@ -498,6 +571,7 @@ class TableRig:
         """Tighten, lift ``lift_height`` off the table, hold ``hold_time`` s; stability and drop checks."""
         h = self.config.hold
         self.tighten()
+        self.release_support()
         start = self.hand_in_object(noisy=False)
         lifted = Pose(self.hand_world().p + [0.0, 0.0, h.lift_height], self.hand_world().q)
         obj = self.backend.get_pose(self.body)
