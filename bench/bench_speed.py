@@ -9,7 +9,9 @@ process (``--workers 0``, a throw-away store) with three counters:
 * ``trial``: CPU time of ``execute_trial`` (backend, robot and strategy set-up,
   the strategy's run, scoring, closing the backend);
 * ``total``: the child's whole CPU time (user + system, from ``wait4``),
-  interpreter start-up and exit included;
+  interpreter start-up and exit included; ``exit``: the part after the
+  command returned (the interpreter's teardown), and whether torch was
+  imported by then;
 * ``trial_import``: CPU time of the (outermost) imports made during the trial
   (the robot factory imports torch, the backend its engine...): paid once per
   process, so the report also gives the ratio and fixed cost with these counted
@@ -148,6 +150,9 @@ def _child(out: str, profile: str | None, argv: list[str]) -> None:
     try:
         cli.main(argv, standalone_mode=False)
     finally:
+        # what is left after this is the interpreter's exit (module teardown): ``exit_cpu``
+        counters["main_end_cpu"] = clock()
+        counters["torch_loaded"] = "torch" in sys.modules
         with open(out, "w") as f:
             json.dump(counters, f)
 
@@ -196,6 +201,7 @@ def measure_trial(
     r["trial_rate"] = sim / r["trial_cpu"] if r["trial_cpu"] else float("nan")
     r["ratio"] = r["engine_cpu"] / r["trial_cpu"] if r["trial_cpu"] else float("nan")
     r["fixed_cpu"] = r["total_cpu"] - r["trial_cpu"]
+    r["exit_cpu"] = r["total_cpu"] - r["main_end_cpu"]
     # the same with the trial's one-off imports counted as start-up (as in a worker's later trials)
     warm = r["trial_cpu"] - r.get("trial_import_cpu", 0.0)
     r["warm_trial_cpu"] = warm
@@ -247,7 +253,9 @@ def main() -> None:
                         f"CPU-s ({r['trial_rate']:5.1f})  ratio {r['ratio']:.3f}  "
                         f"fixed {r['fixed_cpu']:.2f} CPU-s  rc {r['rc']} | trial's imports "
                         f"{r['trial_import_cpu']:.2f} CPU-s: without them ratio {r['warm_ratio']:.3f}, "
-                        f"fixed {r['warm_fixed_cpu']:.2f} CPU-s",
+                        f"fixed {r['warm_fixed_cpu']:.2f} CPU-s | of the fixed cost, the "
+                        f"interpreter's exit {r['exit_cpu']:.2f} CPU-s (torch "
+                        f"{'imported' if r['torch_loaded'] else 'not imported'})",
                         flush=True,
                     )
     if a.protocol:
