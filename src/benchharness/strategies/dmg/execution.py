@@ -75,13 +75,20 @@ class DMGExecConfig:
     """
 
     execution: ExecutionConfig = field(default_factory=ExecutionConfig)
+    #: tighten after every primitive (false: only at the end of the plan)
     regrip_between_primitives: bool = True
+    #: fail as unreachable when the planner could not connect the goal (false: execute the best effort)
     require_goal: bool = False
-    #: closed-loop corrections after each primitive (0: open loop) and their tolerances (m, deg)
+    #: closed-loop corrections after each primitive (0: open loop)
     corrections: int = 2
+    #: m, a correction's position tolerance
     correction_position: float = 0.001
+    #: deg, a correction's angle tolerance
     correction_angle: float = 1.0
+    #: what holds the object while the grasp changes: the table, an ideal fixture, or auto (the
+    #: table where a rest pose keeps the grasp axis horizontal, else the fixture)
     support: Literal["auto", "table", "fixture"] = "auto"
+    #: m, how far above the table the fixture holds the object
     fixture_height: float = 0.2
 
     def __post_init__(self) -> None:

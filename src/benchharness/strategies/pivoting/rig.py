@@ -160,9 +160,10 @@ def stable_rest_poses(
 ) -> list[Pose]:
     """Stable resting poses of the object on a table at z = 0 that keep ``grasp_axis`` (object frame) horizontal.
 
+    Horizontal within ``max_tilt_deg`` (90: every stable pose, for a fixture).
     From trimesh's quasi-static stable poses of the convex hull about the
-    centre of mass; each is turned about the vertical so that the grasp axis
-    lies along world +y, and centred at x = y = 0. Order: most probable first;
+    centre of mass; each is turned about the vertical so that the grasp axis's
+    horizontal part lies along world +y, and centred at x = y = 0. Order: most probable first;
     equal probabilities (a box's opposite faces: trimesh gives them equal to
     ~1e-15, and which comes first then depends on the CPU and library
     release) by the smaller turn from the object's own frame, then by the
@@ -177,7 +178,9 @@ def stable_rest_poses(
         aw = R @ a
         if abs(aw[2]) > math.sin(math.radians(max_tilt_deg)):
             continue
-        yaw = math.atan2(aw[1], aw[0])
+        # a vertical axis (possible only in a fixture) has no heading: no turn, rather than one
+        # set by rounding noise
+        yaw = math.atan2(aw[1], aw[0]) if math.hypot(aw[0], aw[1]) > 1e-9 else math.pi / 2
         Rz = Rotation.from_euler("z", math.pi / 2 - yaw)
         rot = Rz * Rotation.from_matrix(R)
         v = rot.apply(np.asarray(hull.vertices))
