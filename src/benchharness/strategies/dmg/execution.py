@@ -7,7 +7,9 @@ We execute a plan with the table-supported primitives of
 
 * the object rests on the table in a stable pose chosen so that the grasp
   axis is horizontal and the whole plan keeps the gripper clear of the
-  table (:func:`choose_rest`);
+  table (:func:`choose_rest`); where no pose serves (the spatula), an ideal
+  fixture holds it above the table instead until the final lift
+  (``DMGExecConfig.support``);
 * the robot grasps it at the task's initial grasp (plus set-up noise) and the
   set-up grasp is measured;
 * each primitive of the plan is one loosen / move / tighten cycle: a
@@ -348,11 +350,14 @@ def execute_trial(planner, ctx: TrialContext, config: DMGExecConfig | None = Non
     info["support"] = "table" if fixture is None else "fixture"
     info["rest_clearance_mm"] = None if rest is None else worst * 1e3
     if rest is None or worst < ex.motion.min_clearance:
-        why = (
-            "no stable rest pose keeps the grasp axis horizontal"
-            if rest is None
-            else f"on every stable rest pose the plan brings the gripper within {worst * 1e3:.1f} mm of the table"
-        )
+        if rest is None:
+            why = (
+                "the object has no stable pose"
+                if fixture
+                else "no stable rest pose keeps the grasp axis horizontal"
+            )
+        else:
+            why = f"on every stable rest pose the plan brings the gripper within {worst * 1e3:.1f} mm of the table"
         return TrialOutcome(
             failure="unreachable",
             message=f"cannot execute {'in the fixture' if fixture else 'on the table'}: {why}",

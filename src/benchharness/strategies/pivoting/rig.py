@@ -1,7 +1,7 @@
 """The physical scene and primitives shared by the parallel-gripper baselines (pivoting, DMG execution).
 
-Scene: the table (ground plane), one object resting on it in a stable pose,
-the ``pr2-gripper`` robot (PR2 gripper on a stage whose wrist axes meet at
+Scene: the table (ground plane), one object resting on it in a stable pose
+(or held above it by an ideal fixture, :meth:`TableRig.build`), the ``pr2-gripper`` robot (PR2 gripper on a stage whose wrist axes meet at
 the tool centre point). Primitives, all through the Backend interface:
 
 * :meth:`TableRig.setup_grasp` -- grasp the resting object at the task's
