@@ -109,3 +109,26 @@ def test_a_rubiks_robot_builds_and_solves_ik_without_importing_torch():
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=True
     )
     assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout + out.stderr
+
+
+def test_the_dls_solve_is_numpy_linalg_solve_bit_for_bit():
+    """The IK's direct LAPACK call (issue 12) gives np.linalg.solve's result, bit for bit."""
+    from benchharness.robots.kinematics import _solve
+
+    rng = np.random.default_rng(3)
+    for b in (1, 7, 64):
+        j = rng.normal(size=(b, 6, 7))
+        a = j @ j.transpose(0, 2, 1) + 1e-9 * np.eye(6)  # the DLS system: J J^T + damping
+        x = rng.normal(size=(b, 6, 1))
+        np.testing.assert_array_equal(_solve(a, x), np.linalg.solve(a, x))
+
+
+def test_the_numpy_fk_and_jacobian_are_independent_of_the_batch():
+    """A row's FK and Jacobian in a batch are those it has alone (each 4x4 product is its own GEMM)."""
+    arm = next(iter(get_manager().create("robot", "pr2").arms.values()))
+    q = arm.chain.sample(20, UniformStream(2))
+    tip, jac = arm.chain._np.fk_jacobian(q)
+    for i in (0, 7, 19):
+        t1, j1 = arm.chain._np.fk_jacobian(q[i : i + 1])
+        np.testing.assert_array_equal(t1[0], tip[i])
+        np.testing.assert_array_equal(j1[0], jac[i])
