@@ -162,9 +162,20 @@ class DriveState:
         # the same joints re-aimed every physics step with the same gains: the comparison with the
         # arrays is made once per set_targets (version), then only the gain lists are compared
         key = tuple(sel.tolist())
-        gains = (list(stiffness), list(damping), list(force_limit))
         seen = self._verified.get(key)
-        if seen is None or seen[0] != self.version or seen[1] != gains:
+        # lists compare element by element with the verified copies (no copy made per call); any other
+        # sequence type (an array would compare element-wise) is simply verified again
+        if (
+            seen is None
+            or seen[0] != self.version
+            or type(stiffness) is not list
+            or type(damping) is not list
+            or type(force_limit) is not list
+            or seen[1] != stiffness
+            or seen[2] != damping
+            or seen[3] != force_limit
+        ):
+            gains = (list(stiffness), list(damping), list(force_limit))
             if not (
                 bool(self.driven[sel].all())
                 and self.kp[sel].tolist() == gains[0]
@@ -172,9 +183,9 @@ class DriveState:
                 and self.fmax[sel].tolist() == gains[2]
             ):
                 return False
-            self._verified[key] = (self.version, gains)
-        self.target_q[sel] = np.asarray(positions, dtype=float)
-        self.target_v[sel] = np.asarray(velocities, dtype=float)
+            self._verified[key] = (self.version, *gains)
+        self.target_q[sel] = positions  # as float64, as np.asarray(positions, dtype=float) makes them
+        self.target_v[sel] = velocities
         return True
 
     def efforts(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:

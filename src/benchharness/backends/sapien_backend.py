@@ -748,9 +748,10 @@ class SapienBackend(Backend):
             # PhysX: the normal points from the second body towards the first
             (ha, la), (hb, lb), sign = (e1, e0, -1.0) if flip else (e0, e1, 1.0)
             for p in c.points:
-                nrm = sign * np.asarray(p.normal, dtype=float)
+                n64 = np.asarray(p.normal, dtype=float)  # read once (each read makes a new array)
+                nrm = sign * n64
                 imp = np.asarray(p.impulse, dtype=float)
-                fn = abs(float(np.dot(imp, p.normal))) * inv_dt
+                fn = abs(float(np.dot(imp, n64))) * inv_dt  # the float32 normal, widened as np.dot would
                 out.append(
                     Contact(
                         ha,

@@ -513,7 +513,7 @@ class Gripper:
         if not self._ff or self.config.follow:
             return
         tau = self._finger_gravity()
-        if self._sent_gravity is None or np.max(np.abs(tau - self._sent_gravity)) > 0.01:
+        if self._sent_gravity is None or np.abs(tau - self._sent_gravity).max() > 0.01:
             self._send(self._targets)
 
     def _aim_linkages(self) -> None:
@@ -538,16 +538,16 @@ class Gripper:
         if plan is None:
             names = [k.follower for k in links]
             plan = self._link_plan = (
-                tuple(k.leader for k in links),
+                self.robot.joint_index(tuple(k.leader for k in links)),
                 names,
                 [k.stiffness for k in links],
                 [k.damping for k in links],
                 [self.robot.urdf_joints[n].effort for n in names],
             )
         leaders, names, stiffness, damping, force_limit = plan
-        pos, vel = self.robot.joint_motion(leaders)
+        pos, vel = be.get_joint_motion(self.robot.body)  # Robot.joint_motion, its index cached
         # plain floats, not arrays: two or three values per call, NumPy's per-call cost dominated
-        pl, vl = pos.tolist(), vel.tolist()
+        pl, vl = pos[leaders].tolist(), vel[leaders].tolist()
         t = [k.target(p) for k, p in zip(links, pl)]
         v = [k.rate(p) * w for k, p, w in zip(links, pl, vl)]
         moving = max(abs(w) for w in vl) > 1e-4
@@ -704,7 +704,7 @@ class Gripper:
             if stopped.all():
                 break
             at_goal = np.all(stopped | (np.abs(tgt - q_goal) < 1e-12))
-            rest = rest + tick if at_goal and np.max(np.abs(v)) < 0.02 else 0.0
+            rest = rest + tick if at_goal and np.abs(v).max() < 0.02 else 0.0
             if rest >= 0.1:
                 break
         self._targets = tgt.copy()
@@ -761,7 +761,7 @@ class Gripper:
             r.step(chunk)  # Robot.step re-aims follower joints
             t += chunk * dt
             v = r.joint_velocities(names)
-            rest = rest + chunk * dt if np.max(np.abs(v)) < 0.02 else 0.0
+            rest = rest + chunk * dt if np.abs(v).max() < 0.02 else 0.0
             if rest >= 0.1 and t >= 0.1:
                 break
         q = r.joint_positions(names)

@@ -318,7 +318,7 @@ class Robot:
         """
         be = self._require()
         q, _ = be.get_joint_motion(self.body)
-        if self._gcache is None or np.max(np.abs(q - self._gcache[0])) > 1e-4:
+        if self._gcache is None or np.abs(q - self._gcache[0]).max() > 1e-4:
             if be.capabilities.gravity_torques:
                 tau = np.asarray(be.gravity_torques(self.body), dtype=float)
             else:
@@ -372,7 +372,7 @@ class Robot:
         dt = be.config.timestep
         per = max(1, int(round(self.control_period / dt)))
         joints = list(joints)
-        idx = [self.joint_names.index(j) for j in joints]
+        idx = self.joint_index(joints)
         n_ticks = int(np.ceil(traj.duration / (per * dt)))
         max_err = 0.0
         vmax = np.array([self.urdf_joints[j].velocity for j in joints])
@@ -383,8 +383,8 @@ class Robot:
             q_ref, qd_ref = traj.sample(t)
             if k:
                 pos, vel = be.get_joint_motion(self.body)
-                max_err = max(max_err, float(np.max(np.abs(pos[idx] - q_ref))))
-                peak_ratio = max(peak_ratio, float(np.max(np.abs(vel[idx]) / vmax)))
+                max_err = max(max_err, float(np.abs(pos[idx] - q_ref).max()))
+                peak_ratio = max(peak_ratio, float((np.abs(vel[idx]) / vmax).max()))
             self.drive(joints, q_ref, qd_ref)
             if others:
                 self.hold(others)
