@@ -81,3 +81,18 @@ def test_stand_off_move_through_the_table_is_not_clear(scene):
     worst = Q_START + s[int(np.argmin(wrist))] * (Q_GOAL - Q_START)
     assert "r_wrist_flex_link" in _touches_table(b, robot, table, worst)
     assert not _touches_table(b, robot, table, Q_GOAL)
+
+
+def test_a_sweep_checks_start_is_its_first_configuration_bit_for_bit(scene):
+    """``_clears`` reads the start's distance off the path's first configuration instead of checking
+    the start alone (issue 12: a second FK and point transform per check); equal bit for bit to the
+    start checked alone, on paths drawn over the arm's joint range."""
+    machine, hand, *_ = scene
+    points = machine._hand_points(hand)
+    lo, hi = hand.arm.chain.lower, hand.arm.chain.upper
+    rng = np.random.default_rng(4)
+    for _ in range(25):
+        q0, q1 = rng.uniform(lo, hi), rng.uniform(lo, hi)
+        cube, table = machine._sweep_gaps(hand, q0, q1, points, 16)
+        alone = machine.sweep_clearance(hand, q0, q0, points, n=1)
+        assert min(float(cube[0]), float(table[0])) == alone

@@ -321,9 +321,22 @@ def _avoid_note(
     )
 
 
+#: configurations at which a straight joint path is checked (:meth:`BimanualRubiksMachine.sweep_clearance`)
+SWEEP_SAMPLES = 16
+
+
 def _box_gap(local: np.ndarray, half: np.ndarray | float) -> float:
-    """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
-    return float(np.min(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0), axis=1)))
+    """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents).
+
+    ``np.linalg.norm(axis=1)``'s own reduction written out (the same bits, without its dispatch: the
+    sweep checks call this thousands of times a trial)."""
+    return float(_box_dist(local, half).min())
+
+
+def _box_dist(local: np.ndarray, half: np.ndarray | float) -> np.ndarray:
+    """Distance (m) of each of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
+    out = np.maximum(np.abs(local) - half, 0.0)
+    return np.sqrt(np.add.reduce(out * out, axis=1))
 
 
 def _keeps_clear(start: float, least: float, clearance: float) -> bool:
@@ -1017,7 +1030,12 @@ class BimanualRubiksMachine:
         return np.array([cfg.cube_xy[0], cfg.cube_xy[1], h / 2]), np.array([tx, ty, h / 2])
 
     def sweep_clearance(
-        self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int = 16
+        self,
+        hand: Hand,
+        q0: np.ndarray,
+        q1: np.ndarray,
+        points: np.ndarray,
+        n: int = SWEEP_SAMPLES,
     ) -> float:
         """Least distance (m) of the hand's ``points`` (tool frame) along the straight joint path
         ``q0`` -> ``q1`` (the path :meth:`RobotArm.move_to_joints` tracks) from what the hand must not
@@ -1027,12 +1045,18 @@ class BimanualRubiksMachine:
         long tier; a free hand's joint-space swing to its stand-off checked clear of the cube drove the
         wrist into the table's edge at 295 N, where the arm stuck 258 mm from its target, and the
         re-grip closed on nothing (SAPIEN Rubiks-1-50 sensor-aided seed 0, move 38)."""
+        cube, table = self._sweep_gaps(hand, q0, q1, points, n)
+        return min(float(cube.min()), float(table.min()))
+
+    def _sweep_gaps(
+        self, hand: Hand, q0: np.ndarray, q1: np.ndarray, points: np.ndarray, n: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`sweep_clearance`'s least distances from the believed cube and from the table at each
+        of the ``n`` configurations of the path, (n,) each."""
         p = self._path_points(hand, q0, q1, points, n)
         centre, half = self.table_box()
-        return min(
-            _box_gap(self.est.rotation.inv().apply(p - self.est.p), CUBE_HALF),
-            _box_gap(p - centre, half),
-        )
+        cube = _box_dist(self.est.rotation.inv().apply(p - self.est.p), CUBE_HALF)
+        return cube.reshape(n, -1).min(axis=1), _box_dist(p - centre, half).reshape(n, -1).min(axis=1)
 
     @staticmethod
     def _path_points(
@@ -1085,9 +1109,12 @@ class BimanualRubiksMachine:
         the cube: open pads 16 mm from its faces), than it starts less 5 mm (at most half of it). A
         joint-space step of a few centimetres strays a few millimetres from its straight Cartesian line
         (measured: 2-3 mm for 2 cm steps of a PR2 giver's retreat); a sweep through the cube reaches 0."""
-        start = self.sweep_clearance(hand, q0, q0, points, n=1)
+        # the path's first configuration is q0 itself: its distances are the start's (each
+        # configuration's points are computed alone; tests/strategies/test_free_hand_clearance.py)
+        cube, table = self._sweep_gaps(hand, q0, q1, points, SWEEP_SAMPLES)
+        start = min(float(cube[0]), float(table[0]))
         return _keeps_clear(
-            start, self.sweep_clearance(hand, q0, q1, points), self.config.sweep_clearance
+            start, min(float(cube.min()), float(table.min())), self.config.sweep_clearance
         )
 
     def _arm_margin_hook(self) -> Callable[..., np.ndarray] | None:
