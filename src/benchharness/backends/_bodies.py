@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, ItemsView, Iterator, Sequence, ValuesView
 from dataclasses import dataclass, field
-from typing import Generic, TypeVar
+from typing import Generic, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -73,9 +73,8 @@ def as_array(v: float | Sequence[float], n: int, what: str) -> np.ndarray:
     return a
 
 
-@dataclass(frozen=True)
-class DriveCommand:
-    """Per-joint PD drive settings for the selected joints."""
+class DriveCommand(NamedTuple):
+    """Per-joint PD drive settings for the selected joints (a named tuple: built every control tick)."""
 
     q: np.ndarray  #: position targets
     v: np.ndarray  #: velocity targets
@@ -106,7 +105,8 @@ def drive_command(
         f = np.array([joints[i].max_effort for i in sel], dtype=float)
     else:
         f = as_array(force_limit, n, "force_limit")
-    f = np.where(np.isfinite(f), f, UNLIMITED_FORCE)
+    if not np.isfinite(f).all():  # (checked first: caps are nearly always finite)
+        f = np.where(np.isfinite(f), f, UNLIMITED_FORCE)
     if positions is None:
         q = np.asarray(current_positions(), dtype=float)[sel]
         if velocities is not None:
@@ -184,7 +184,9 @@ class DriveState:
             ):
                 return False
             self._verified[key] = (self.version, *gains)
-        self.target_q[sel] = positions  # as float64, as np.asarray(positions, dtype=float) makes them
+        self.target_q[sel] = (
+            positions  # as float64, as np.asarray(positions, dtype=float) makes them
+        )
         self.target_v[sel] = velocities
         return True
 

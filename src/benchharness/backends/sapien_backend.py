@@ -180,6 +180,9 @@ class SapienBackend(Backend):
         self._engine_step: Any = self._system.step
         self._bodies: BodyTable[_Body] = BodyTable()
         self._entity_map: dict[int, tuple[int, str | None]] = {}  # per_scene_id -> (handle, link)
+        #: the same, keyed by the physical component itself (a contact's ``bodies``): SAPIEN hands
+        #: back one Python object per component, and this saves two engine calls per contact body
+        self._component_map: dict[Any, tuple[int, str | None]] = {}
         self._constraints: dict[int, Any] = {}
         self._next_constraint = 1
         self._steps = 0
@@ -216,6 +219,7 @@ class SapienBackend(Backend):
         self._bodies.close()
         self._constraints.clear()
         self._entity_map.clear()
+        self._component_map.clear()
         try:
             self._scene.clear()
         except Exception:  # noqa: BLE001 - best effort
@@ -248,8 +252,10 @@ class SapienBackend(Backend):
             for name, comp in b.links.items():
                 link = None if name == root else name
                 self._entity_map[comp.entity.per_scene_id] = (b.handle, link)
+                self._component_map[comp] = (b.handle, link)
         else:
             self._entity_map[b.entity.per_scene_id] = (b.handle, None)
+            self._component_map[b.component] = (b.handle, None)
         return b.handle
 
     def _new_handle(self) -> int:
@@ -464,9 +470,11 @@ class SapienBackend(Backend):
         if b.articulation is not None:
             for comp in b.links.values():
                 self._entity_map.pop(comp.entity.per_scene_id, None)
+                self._component_map.pop(comp, None)
             self._scene.remove_articulation(b.articulation)
         else:
             self._entity_map.pop(b.entity.per_scene_id, None)
+            self._component_map.pop(b.component, None)
             self._scene.remove_entity(b.entity)
         self._bodies.pop(body)
         self._roots = None
@@ -736,10 +744,11 @@ class SapienBackend(Backend):
             return out_held
         inv_dt = 1.0 / self.config.timestep
         out: list[Contact] = []
-        emap = self._entity_map
+        cmap = self._component_map
         for c in self._system.get_contacts():
-            e0 = emap.get(c.bodies[0].entity.per_scene_id)
-            e1 = emap.get(c.bodies[1].entity.per_scene_id)
+            c0, c1 = c.bodies
+            e0 = cmap.get(c0) or self._entity_map.get(c0.entity.per_scene_id)
+            e1 = cmap.get(c1) or self._entity_map.get(c1.entity.per_scene_id)
             if e0 is None or e1 is None:
                 continue
             flip = contact_side(e0[0], e1[0], body_a, body_b)
@@ -751,7 +760,9 @@ class SapienBackend(Backend):
                 n64 = np.asarray(p.normal, dtype=float)  # read once (each read makes a new array)
                 nrm = sign * n64
                 imp = np.asarray(p.impulse, dtype=float)
-                fn = abs(float(np.dot(imp, n64))) * inv_dt  # the float32 normal, widened as np.dot would
+                fn = (
+                    abs(float(np.dot(imp, n64))) * inv_dt
+                )  # the float32 normal, widened as np.dot would
                 out.append(
                     Contact(
                         ha,

@@ -506,7 +506,7 @@ class Gripper:
         r = self.robot
         if not r.backend.capabilities.gravity_torques:
             return np.zeros(len(self.joints))
-        return np.asarray(r._gravity_all()[r.joint_index(list(self.joints))], dtype=float)
+        return np.asarray(r._gravity_all()[r.joint_index(self.joints)], dtype=float)
 
     def _refresh_gravity(self) -> None:
         """Re-send the targets when the fingers' gravity load moved (> 0.01 N): the wrist turned."""

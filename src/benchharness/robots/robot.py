@@ -268,8 +268,7 @@ class Robot:
                 idx,
                 k,
                 d,
-                k.tolist(),
-                d.tolist(),
+                np.maximum(k, 1e-9),  # the feed-forward's divisor
                 eff,
                 sel,
                 idx[sel],
@@ -283,25 +282,26 @@ class Robot:
         be = self._require()
         if not len(joints):  # nothing to drive
             return
-        names, idx, k, d, k_list, d_list, eff, sel, gidx, carried = self._drive_plan(tuple(joints))
+        names, idx, k, d, k_floor, eff, sel, gidx, carried = self._drive_plan(tuple(joints))
         self._targets[idx] = q
         tau = np.zeros(len(names))
         if sel.size:
             tau[sel] = self._gravity_all()[gidx]
         limit = eff + np.where(carried, np.abs(tau), 0.0)
+        # arrays, not lists: the backend reads each argument as an array (the plan's are not modified)
         be.set_joint_targets(
             self.body,
-            q + tau / np.maximum(k, 1e-9),
+            q + tau / k_floor,
             np.zeros(len(names)) if qd is None else qd,
             joints=names,
-            stiffness=k_list,
-            damping=d_list,
-            force_limit=limit.tolist(),
+            stiffness=k,
+            damping=d,
+            force_limit=limit,
         )
 
     def _gravity_torques(self, joints: list[str]) -> np.ndarray:
         """Gravity holding torques of ``joints`` (0 for hand joints)."""
-        _, _, _, _, _, _, _, sel, gidx, _ = self._drive_plan(tuple(joints))
+        _, _, _, _, _, _, sel, gidx, _ = self._drive_plan(tuple(joints))
         tau = np.zeros(len(joints))
         if sel.size:
             tau[sel] = self._gravity_all()[gidx]

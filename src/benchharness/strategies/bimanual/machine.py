@@ -1056,7 +1056,9 @@ class BimanualRubiksMachine:
         p = self._path_points(hand, q0, q1, points, n)
         centre, half = self.table_box()
         cube = _box_dist(self.est.rotation.inv().apply(p - self.est.p), CUBE_HALF)
-        return cube.reshape(n, -1).min(axis=1), _box_dist(p - centre, half).reshape(n, -1).min(axis=1)
+        return cube.reshape(n, -1).min(axis=1), _box_dist(p - centre, half).reshape(n, -1).min(
+            axis=1
+        )
 
     @staticmethod
     def _path_points(
