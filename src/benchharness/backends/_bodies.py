@@ -154,11 +154,11 @@ class DriveState:
         stiffness: Sequence[float],
         damping: Sequence[float],
         force_limit: Sequence[float],
-    ) -> bool:
+    ) -> tuple[int, ...] | None:
         """New targets for joints ``sel`` if they are driven with exactly these gains and (finite)
-        caps, and say so; False: nothing set (the full :meth:`set_targets` is needed). Each engine's
-        ``_retarget_driven`` hook (:meth:`benchharness.backends.Backend.retarget_joints`) is this
-        and whatever its engine must be told."""
+        caps: the joint indices set; None: nothing set (the full :meth:`set_targets` is needed). Each
+        engine's ``_retarget_driven`` hook (:meth:`benchharness.backends.Backend.retarget_joints`) is
+        this and whatever its engine must be told."""
         # the same joints re-aimed every physics step with the same gains: the comparison with the
         # arrays is made once per set_targets (version), then only the gain lists are compared
         key = tuple(sel.tolist())
@@ -182,13 +182,18 @@ class DriveState:
                 and self.kd[sel].tolist() == gains[1]
                 and self.fmax[sel].tolist() == gains[2]
             ):
-                return False
+                return None
             self._verified[key] = (self.version, *gains)
-        self.target_q[sel] = (
-            positions  # as float64, as np.asarray(positions, dtype=float) makes them
-        )
-        self.target_v[sel] = velocities
-        return True
+        if len(positions) != len(key) or len(velocities) != len(key):
+            raise BackendError(
+                f"retarget: {len(key)} joints, {len(positions)} positions, {len(velocities)} velocities"
+            )
+        # element by element (two or three joints a call): the same float64 values as an array set
+        tq, tv = self.target_q, self.target_v
+        for i, x, w in zip(key, positions, velocities):
+            tq[i] = x
+            tv[i] = w
+        return key
 
     def efforts(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The capped drive law at ``(q, v)``, ``-sign(v) friction`` for undriven joints.

@@ -986,7 +986,7 @@ class PyBulletBackend(Backend):
     ) -> bool:
         b = self._b(body)
         sel = b.joint_selection(joints)
-        if not b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit):
+        if b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit) is None:
             return False
         b.drive_cache = None
         return True

@@ -628,16 +628,15 @@ class SapienBackend(Backend):
     ) -> bool:
         b = self._b(body)
         sel = b.joint_selection(joints)
-        if not b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit):
+        idx = b.drive.retarget(sel, positions, velocities, stiffness, damping, force_limit)
+        if idx is None:
             return False
         # the values just stored, as Python floats (what target_q[sel].tolist() gives back)
-        self._send_targets(
-            b, sel.tolist(), [float(x) for x in positions], [float(x) for x in velocities]
-        )
+        self._send_targets(b, idx, [float(x) for x in positions], [float(x) for x in velocities])
         return True
 
     @staticmethod
-    def _send_targets(b: _Body, sel: list[int], q: list[float], v: list[float]) -> None:
+    def _send_targets(b: _Body, sel: Sequence[int], q: list[float], v: list[float]) -> None:
         """Position and velocity targets to PhysX, only those that changed (each setter is a C++ call)."""
         targets = b.drive_targets
         for i, qi, vi in zip(sel, q, v):

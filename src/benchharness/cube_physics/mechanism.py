@@ -234,7 +234,7 @@ class PhysicalCube:
         """
         if self._axis is None:
             return
-        q = self.backend.get_joint_state(self._body).positions
+        q = self.backend.get_joint_motion(self._body)[0]  # positions only (no drive efforts)
         k = np.rint(np.asarray(q, dtype=float) / _QUARTER).astype(np.int64)
         if not np.array_equal(k, self._targets):
             self._targets = k
