@@ -759,9 +759,8 @@ class SapienBackend(Backend):
                 n64 = np.asarray(p.normal, dtype=float)  # read once (each read makes a new array)
                 nrm = sign * n64
                 imp = np.asarray(p.impulse, dtype=float)
-                fn = (
-                    abs(float(np.dot(imp, n64))) * inv_dt
-                )  # the float32 normal, widened as np.dot would
+                # the float32 normal widened first, as np.dot widens it: the same product
+                fn = abs(float(np.dot(imp, n64))) * inv_dt
                 out.append(
                     Contact(
                         ha,
