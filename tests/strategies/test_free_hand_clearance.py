@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from benchharness.geometry import Pose
-from benchharness.strategies.bimanual.machine import Hand
+from benchharness.strategies.bimanual.machine import SWEEP_SAMPLES, Hand
 from benchharness.strategies.pr2_rubiks.config import PR2RubiksConfig
 from benchharness.strategies.pr2_rubiks.strategy import WRIST_RADIUS, SensorAidedStrategy
 
@@ -93,6 +93,6 @@ def test_a_sweep_checks_start_is_its_first_configuration_bit_for_bit(scene):
     rng = np.random.default_rng(4)
     for _ in range(25):
         q0, q1 = rng.uniform(lo, hi), rng.uniform(lo, hi)
-        cube, table = machine._sweep_gaps(hand, q0, q1, points, 16)
+        cube, table = machine._sweep_gaps(hand, q0, q1, points, SWEEP_SAMPLES)
         alone = machine.sweep_clearance(hand, q0, q0, points, n=1)
         assert min(float(cube[0]), float(table[0])) == alone

@@ -51,6 +51,7 @@ __all__ = [
     "KinematicTree",
     "UniformStream",
     "pose_error",
+    "row_norm",
 ]
 
 _NUMPY_FK_MAX_BATCH = 32  #: above this, pytorch-kinematics' batched FK is as fast as the NumPy loop
@@ -237,8 +238,9 @@ def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return _SOLVE(a, b, signature="dd->d")
 
 
-def _row_norm(a: np.ndarray) -> np.ndarray:
-    """``np.linalg.norm(a, axis=1)`` for a real (B, n) array: the same reduction, without its dispatch."""
+def row_norm(a: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(a, axis=1)`` for a real (B, n) array: the same reduction, bit for bit, without
+    its dispatch (for the small arrays of per-step and per-iteration checks)."""
     return np.sqrt(np.add.reduce(a * a, axis=1))
 
 
@@ -252,7 +254,7 @@ def _rotvec_between(target: np.ndarray, current: np.ndarray) -> np.ndarray:
     r = target @ current.transpose(0, 2, 1)
     # (r21 - r12, r02 - r20, r10 - r01): component i = r[i+2, i+1] - r[i+1, i+2]
     v = 0.5 * (r[:, _AFTER, _NEXT] - r[:, _NEXT, _AFTER])
-    n = _row_norm(v)
+    n = row_norm(v)
     angle = np.arctan2(n, 0.5 * (r.trace(axis1=1, axis2=2) - 1.0))  # the trace: r00 + r11, + r22
     out = v * (angle / np.maximum(n, 1e-300))[:, None]  # n = 0 only at angle 0 (angle pi: below)
     flip = angle > np.pi - 1e-3
@@ -646,7 +648,7 @@ class KinematicChain:
         for it in range(iterations + 1):  # the last pass only tests the last step
             qa = q[idx]
             dx, jac = error(qa, None if idx.size == full else idx)
-            conv = (_row_norm(dx[:, :3]) < pos_tol) & (_row_norm(dx[:, 3:]) < rot_tol)
+            conv = (row_norm(dx[:, :3]) < pos_tol) & (row_norm(dx[:, 3:]) < rot_tol)
             if not conv.any():  # the usual pass: every active row steps on (no index bookkeeping)
                 if it == iterations:
                     sol[idx] = qa
@@ -669,7 +671,7 @@ class KinematicChain:
             dx, jac = error(q, None)
             q = step(q, dx, jac)
         dx, _ = error(q, None)
-        ep, er = _row_norm(dx[:, :3]), _row_norm(dx[:, 3:])
+        ep, er = row_norm(dx[:, :3]), row_norm(dx[:, 3:])
         conv = (ep < pos_tol) & (er < rot_tol)
         return q.reshape(b, r, dof), ep.reshape(b, r), er.reshape(b, r), conv.reshape(b, r)
 

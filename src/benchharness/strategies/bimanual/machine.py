@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 
 from ...backends.interface import Backend, BodyId, Box, CameraSpec
 from ...geometry import Pose
-from ...robots.kinematics import IKResult
+from ...robots.kinematics import IKResult, row_norm
 from ...runner.contract import RubiksItem, TrialContext, TrialOutcome
 from ..regrasp import (
     HandModel,
@@ -326,17 +326,16 @@ SWEEP_SAMPLES = 16
 
 
 def _box_gap(local: np.ndarray, half: np.ndarray | float) -> float:
-    """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents).
-
-    ``np.linalg.norm(axis=1)``'s own reduction written out (the same bits, without its dispatch: the
-    sweep checks call this thousands of times a trial)."""
+    """Least distance (m) of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
     return float(_box_dist(local, half).min())
 
 
 def _box_dist(local: np.ndarray, half: np.ndarray | float) -> np.ndarray:
-    """Distance (m) of each of ``local`` points (N x 3, in a box's frame) from that box (half extents)."""
-    out = np.maximum(np.abs(local) - half, 0.0)
-    return np.sqrt(np.add.reduce(out * out, axis=1))
+    """Distance (m) of each of ``local`` points (N x 3, in a box's frame) from that box (half extents).
+
+    ``row_norm``: ``np.linalg.norm(axis=1)``'s bits without its dispatch (the sweep checks run this
+    thousands of times a trial)."""
+    return row_norm(np.maximum(np.abs(local) - half, 0.0))
 
 
 def _keeps_clear(start: float, least: float, clearance: float) -> bool:
@@ -1056,9 +1055,8 @@ class BimanualRubiksMachine:
         p = self._path_points(hand, q0, q1, points, n)
         centre, half = self.table_box()
         cube = _box_dist(self.est.rotation.inv().apply(p - self.est.p), CUBE_HALF)
-        return cube.reshape(n, -1).min(axis=1), _box_dist(p - centre, half).reshape(n, -1).min(
-            axis=1
-        )
+        table = _box_dist(p - centre, half)
+        return cube.reshape(n, -1).min(axis=1), table.reshape(n, -1).min(axis=1)
 
     @staticmethod
     def _path_points(
