@@ -145,10 +145,15 @@ def _child(out: str, profile: str | None, argv: list[str]) -> None:
                 in_trial[0] = False
 
         sweep.execute_trial = trial
-    from benchharness.cli.main import cli
+    import inspect
+
+    from benchharness.cli import main as entry
 
     try:
-        cli.main(argv, standalone_mode=False)
+        if inspect.signature(entry.main).parameters:
+            entry.main(argv)  # the console script's own path, its exit included
+        else:  # code from before main() took arguments (for --src comparisons)
+            entry.cli.main(argv, standalone_mode=False)
     finally:
         # what is left after this is the interpreter's exit (module teardown): ``exit_cpu``
         counters["main_end_cpu"] = clock()

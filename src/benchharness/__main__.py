@@ -1,5 +1,5 @@
 """``python -m benchharness``: the same command line as the ``benchharness`` script (no PATH needed)."""
 
-from benchharness.cli.main import cli
+from benchharness.cli.main import main
 
-cli(prog_name="benchharness")
+main(prog_name="benchharness")

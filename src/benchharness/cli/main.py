@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import importlib
 import os
 import sys
@@ -85,8 +86,24 @@ def cli() -> None:
     """
 
 
-def main() -> None:
-    cli()
+def main(argv: list[str] | None = None, prog_name: str | None = None) -> None:
+    """The console script: the command, then a cheaper interpreter exit.
+
+    After the command has returned (its results written, its files closed),
+    every object still alive is moved out of the garbage collector's reach
+    (``gc.freeze``). The interpreter's exit would otherwise run full cycle
+    collections over them: with torch imported (a Rubik's trial's arm check
+    imports it through pytorch-kinematics) that traversal cost ~0.25 CPU-s,
+    a quarter of a ``run`` command's 1 CPU-s fixed-cost target (issue 12,
+    BENCHMARKS.md "exit freeze"). Reference counting still frees objects and
+    ``atexit`` handlers (process pools, Ray) still run; only cyclic garbage
+    left at exit goes back to the OS with the process instead of being
+    collected first.
+    """
+    try:
+        cli.main(argv, prog_name=prog_name)
+    finally:
+        gc.freeze()
 
 
 if __name__ == "__main__":
