@@ -130,6 +130,7 @@ def test_rows_roundtrip_and_resume_bookkeeping(store_path):
         rows = store.trials(run_key=spec.run_key)
     assert [r.trial_index for r in rows] == [1, 2]
     ok, bad = rows
+    assert ok.comparable() == _rec(spec, 1).comparable()  # the row is the record it stored
     assert (
         ok.status is TrialStatus.SUCCESS
         and ok.score == 11.0

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from .causes import FailureCause, TrialStatus
 
-__all__ = ["TrialRecord"]
+__all__ = ["TrialRecord", "comparable_fields"]
 
 
 @dataclass(frozen=True)
@@ -42,14 +42,47 @@ class TrialRecord:
 
     def comparable(self) -> dict[str, Any]:
         """Everything but the wall-clock measurements (for determinism checks)."""
-        return {
-            "trial_index": self.trial_index,
-            "status": self.status.value,
-            "score": self.score,
-            "failure_cause": self.failure_cause.value if self.failure_cause else None,
-            "sim_s": self.sim_s,
-            "first_contact_s": self.first_contact_s,
-            "termination_s": self.termination_s,
-            "outcome": self.outcome,
-            "diagnostics": self.diagnostics,
-        }
+        return comparable_fields(self)
+
+
+class _TrialFields(Protocol):
+    """What a trial's record and its stored row share (:class:`TrialRecord`, ``StoredTrial``)."""
+
+    @property
+    def trial_index(self) -> int: ...
+    @property
+    def status(self) -> TrialStatus: ...
+    @property
+    def score(self) -> float | None: ...
+    @property
+    def failure_cause(self) -> FailureCause | None: ...
+    @property
+    def sim_s(self) -> float | None: ...
+    @property
+    def first_contact_s(self) -> float | None: ...
+    @property
+    def termination_s(self) -> float | None: ...
+    @property
+    def outcome(self) -> dict[str, Any]: ...
+    @property
+    def diagnostics(self) -> dict[str, Any]: ...
+
+
+def comparable_fields(rec: _TrialFields) -> dict[str, Any]:
+    """A trial's result without its wall-clock measurements, code version or run metadata.
+
+    The one definition of "the same result" for determinism checks: a record
+    fresh from a worker and a row read back from a store compare equal through
+    it when the trial repeated bit for bit.
+    """
+    return {
+        "trial_index": rec.trial_index,
+        "status": rec.status.value,
+        "score": rec.score,
+        "failure_cause": rec.failure_cause.value if rec.failure_cause else None,
+        "sim_s": rec.sim_s,
+        "first_contact_s": rec.first_contact_s,
+        "termination_s": rec.termination_s,
+        "outcome": rec.outcome,
+        "diagnostics": rec.diagnostics,
+    }

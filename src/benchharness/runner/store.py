@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from .causes import FailureCause, TrialStatus
-from .records import TrialRecord
+from .records import TrialRecord, comparable_fields
 from .spec import RunSpec
 
 __all__ = [
@@ -350,17 +350,8 @@ class StoredTrial:
         return f"{self.strategy}{sensors}{opts} ({self.robot}, {self.backend})"
 
     def comparable(self) -> dict[str, Any]:
-        return {
-            "trial_index": self.trial_index,
-            "status": self.status.value,
-            "score": self.score,
-            "failure_cause": self.failure_cause.value if self.failure_cause else None,
-            "sim_s": self.sim_s,
-            "first_contact_s": self.first_contact_s,
-            "termination_s": self.termination_s,
-            "outcome": self.outcome,
-            "diagnostics": self.diagnostics,
-        }
+        """Everything but the wall-clock measurements, as :meth:`TrialRecord.comparable`."""
+        return comparable_fields(self)
 
 
 class ResultsStore:
