@@ -222,3 +222,28 @@ def test_grid_from_toml_with_physics_axis(tmp_path, store_path):
     bad.write_text('tasks = ["Rubiks-5-5"]\nrobot = "x"\n')
     res = _invoke(str(bad), "--store", str(store_path))
     assert res.exit_code == 2 and "unknown key 'robot'" in res.stderr
+
+
+def test_the_whole_table_one_grid_is_each_baseline_on_its_published_robot():
+    """``bench/table1_all.toml`` is the whole Table I sweep of issue 12 (BENCHMARKS.md): the paper's
+    twelve tiers for its three baselines on both engines, each baseline on the robot it was
+    published on (the two PR2 methods, HERB's push-grasp), and the grid's other pairs skipped."""
+    from collections import Counter
+    from pathlib import Path
+
+    from benchharness.cube.tiers import load_tiers
+
+    path = Path(__file__).resolve().parents[2] / "bench" / "table1_all.toml"
+    plan = expand(load_grid(path))
+    per_method = Counter((s.strategy, s.robot, s.backend) for s in plan.specs)
+    assert per_method == {
+        (strategy, robot, backend): 12
+        for strategy, robot in (
+            ("dead-reckoning", "pr2"),
+            ("sensor-aided", "pr2"),
+            ("push-grasp", "herb"),
+        )
+        for backend in ("sapien", "pybullet")
+    }
+    tasks = list(dict.fromkeys(s.task for s in plan.specs))
+    assert tasks == list(load_tiers()) and len(plan.skipped) == 3 * 12  # the paper's order
