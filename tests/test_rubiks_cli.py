@@ -272,7 +272,7 @@ def test_python_dash_m_runs_the_same_command_line():
 
 def test_console_script_exits_without_collecting_what_it_leaves():
     """The console script moves what is still alive out of the collector's reach once the command
-    has returned (``gc.freeze``; its exit's cycle collections cost ~0.25 CPU-s with torch imported,
+    has returned (``gc.freeze``; its exit's cycle collections cost 0.3-0.5 CPU-s with torch imported,
     BENCHMARKS.md "exit freeze"), on success and on bad input alike, and its exit code is kept.
     Observed from an ``atexit`` hook, which runs after the command and before the teardown."""
     import subprocess

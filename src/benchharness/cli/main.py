@@ -93,9 +93,9 @@ def main(argv: list[str] | None = None, prog_name: str | None = None) -> None:
     every object still alive is moved out of the garbage collector's reach
     (``gc.freeze``). The interpreter's exit would otherwise run full cycle
     collections over them: with torch imported (a Rubik's trial's arm check
-    imports it through pytorch-kinematics) that traversal cost ~0.25 CPU-s,
-    a quarter of a ``run`` command's 1 CPU-s fixed-cost target (issue 12,
-    BENCHMARKS.md "exit freeze"). Reference counting still frees objects and
+    imports it through pytorch-kinematics) that traversal cost 0.3-0.5 CPU-s
+    of a Rubiks-1-20 ``run`` command's exit, against a 1 CPU-s fixed-cost
+    target (issue 12, BENCHMARKS.md "exit freeze"). Reference counting still frees objects and
     ``atexit`` handlers (process pools, Ray) still run; only cyclic garbage
     left at exit goes back to the OS with the process instead of being
     collected first.
