@@ -70,19 +70,21 @@ def _twist_axes(m, t) -> None:
         tool = h.arm.tcp_pose()
         lt = tool.inv().apply(true.p)
         lb = tool.inv().apply(m.est.p)
-        try:
-            x_neg, x_pos, z_neg, z_pos = m.grasp._pinch_sides(m, h)
-            fingers = (
-                f"fingers' middle x {1000 * 0.5 * (x_neg + x_pos):+.1f} width {1000 * (x_pos - x_neg):.1f} "
-                f"depths {1000 * z_neg:.1f}/{1000 * z_pos:.1f}"
-            )
-        except Exception as e:  # noqa: BLE001 - diagnostic
-            fingers = f"({e})"
+        fingers = ""  # the pinch reading is HERB's push-grasp (the PR2's parallel jaws have none)
+        if hasattr(m.grasp, "_pinch_sides"):
+            try:
+                x_neg, x_pos, z_neg, z_pos = m.grasp._pinch_sides(m, h)
+                fingers = (
+                    f"; fingers' middle x {1000 * 0.5 * (x_neg + x_pos):+.1f} "
+                    f"width {1000 * (x_pos - x_neg):.1f} depths {1000 * z_neg:.1f}/{1000 * z_pos:.1f}"
+                )
+            except Exception as e:  # noqa: BLE001 - diagnostic
+                fingers = f"; ({e})"
         role = "rotator" if h.side == t.gripper else "holder"
         print(
             f"t={m.b.time:8.2f} twist {t.source} {t.face}{t.quarter_turns} {role} {h.side} d{h.depth}: "
             f"true centre in tool x {1000 * lt[0]:+.1f} y {1000 * lt[1]:+.1f} z {1000 * lt[2]:+.1f}; "
-            f"believed x {1000 * lb[0]:+.1f} y {1000 * lb[1]:+.1f} z {1000 * lb[2]:+.1f}; {fingers}",
+            f"believed x {1000 * lb[0]:+.1f} y {1000 * lb[1]:+.1f} z {1000 * lb[2]:+.1f}{fingers}",
             flush=True,
         )
 
