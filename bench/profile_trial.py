@@ -193,6 +193,8 @@ def main() -> None:
     if args.raw:
         print(json.dumps(report(split(args.raw)), indent=1))
         return
+    if args.keep:
+        os.makedirs(args.keep, exist_ok=True)
     for label in args.only.split(","):
         for backend in args.backends.split(","):
             keep = os.path.join(args.keep, f"{label}-{backend}.txt") if args.keep else None
