@@ -176,9 +176,13 @@ def profile(label: str, backend: str, rate: int, keep: str | None) -> dict[str, 
             os.path.join(tmp, "s.sqlite"),
         ]
         env = dict(os.environ, OMP_NUM_THREADS="1")
-        subprocess.run(
-            cmd, check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env
+        proc = subprocess.run(
+            cmd, check=False, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env
         )
+        if not os.path.exists(raw) or not os.path.getsize(raw):
+            # e.g. py-spy not installed, or not allowed to read another process (ptrace)
+            last = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+            sys.exit(f"profile_trial: py-spy wrote no profile for {label} on {backend}: {last}")
         return split(raw)
 
 
@@ -193,10 +197,15 @@ def main() -> None:
     if args.raw:
         print(json.dumps(report(split(args.raw)), indent=1))
         return
+    labels, backends = args.only.split(","), args.backends.split(",")
+    for bad in [x for x in labels if x not in TRIALS]:
+        ap.error(f"--only: unknown trial {bad!r} (one of {', '.join(TRIALS)})")
+    for bad in [x for x in backends if x not in ("pybullet", "sapien")]:
+        ap.error(f"--backends: unknown backend {bad!r} (pybullet or sapien)")
     if args.keep:
         os.makedirs(args.keep, exist_ok=True)
-    for label in args.only.split(","):
-        for backend in args.backends.split(","):
+    for label in labels:
+        for backend in backends:
             keep = os.path.join(args.keep, f"{label}-{backend}.txt") if args.keep else None
             res = report(profile(label, backend, args.rate, keep))
             print(json.dumps({"trial": label, "backend": backend, **res}, indent=1))
