@@ -46,7 +46,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_speed import TRIALS
 
 #: kinds of work outside the engine's step, each a pattern on a frame's "function (file)";
-#: the deepest matching frame of a sample names its kind
+#: the deepest matching frame of a sample names its kind. Shared helpers (FK, Jacobians,
+#: rotations) are named by none: their time goes to the work that called them (IK or a check)
 KINDS: tuple[tuple[str, str], ...] = (
     (
         "per step: drive law (PyBullet's mass matrix, inverse dynamics)",
@@ -71,9 +72,9 @@ KINDS: tuple[tuple[str, str], ...] = (
         r"(_relocalise_sweep\.<locals>\.read|\w+Backend\.ray_cast|KalmanFilter|filterpy)",
     ),
     (
-        "per motion: planning and checks (FK, swept paths)",
+        "per motion: planning and checks (grasp choice, swept paths, detours)",
         r"^(BimanualRubiksMachine\.(transit|turn_travel|_make_detour)|_clears|PR2Grasp\.choose|"
-        r"_path_points|_SerialModel\.fk_jacobian|KinematicChain\.fk) ",
+        r"_path_points) ",
     ),
     # an in-hand trial's plan is the method itself (the paper times it apart, Table II)
     ("per trial: in-grasp planning (the method's optimisation)", r"/ingrasp/planner\.py\)$"),
