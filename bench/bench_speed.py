@@ -52,6 +52,11 @@ TRIALS = {
 PROTOCOL = ["rubiks", "expect", "--sequence", "R U"]
 
 
+def trial_argv(label: str, backend: str, store: str) -> list[str]:
+    """The ``benchharness`` arguments of one of :data:`TRIALS` (also what profile_trial.py samples)."""
+    return ["run", *TRIALS[label].split(), "--backend", backend, "--workers", "0", "--store", store]
+
+
 def _child(out: str, profile: str | None, argv: list[str]) -> None:
     """Run the CLI in this process with the engine and trial counters; write them to ``out``."""
     counters = {
@@ -197,9 +202,7 @@ def measure_trial(
     label: str, backend: str, profile: str | None = None, src: str | None = None
 ) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
-        argv = ["run", *TRIALS[label].split(), "--backend", backend, "--workers", "0"]
-        argv += ["--store", os.path.join(tmp, "s.sqlite")]
-        r = _run_child(argv, profile, src)
+        r = _run_child(trial_argv(label, backend, os.path.join(tmp, "s.sqlite")), profile, src)
     sim = r["engine_steps"] * r["dt"]
     r["sim_s"] = sim
     r["engine_rate"] = sim / r["engine_cpu"] if r["engine_cpu"] else float("nan")

@@ -43,7 +43,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_speed import TRIALS
+from bench_speed import TRIALS, trial_argv
 
 #: kinds of work outside the engine's step, each a pattern on a frame's "function (file)";
 #: the deepest matching frame of a sample names its kind. Shared helpers (FK, Jacobians,
@@ -119,10 +119,8 @@ def split(raw: str) -> dict[str, int]:
         frames = [_FRAME.match(f) for f in stack.split(";")]
         named = [f"{m['func']} ({m['file']})" if m else "" for m in frames]
         if not any(x.startswith("execute_trial ") for x in named):
+            # the store's claim-renewing thread too: its stack starts at its own bootstrap
             counts["outside the trial (start-up, exit, store)"] += int(n)
-            continue
-        if any(m and m["file"].startswith("threading.py") for m in frames):
-            counts["store's claim thread (waiting)"] += int(n)  # sampled asleep; no CPU
             continue
         if any("importlib" in x for x in named):
             counts[IMPORTS] += int(n)
@@ -167,14 +165,7 @@ def profile(label: str, backend: str, rate: int, keep: str | None) -> dict[str, 
             sys.executable,
             "-m",
             "benchharness.cli.main",
-            "run",
-            *TRIALS[label].split(),
-            "--backend",
-            backend,
-            "--workers",
-            "0",
-            "--store",
-            os.path.join(tmp, "s.sqlite"),
+            *trial_argv(label, backend, os.path.join(tmp, "s.sqlite")),
         ]
         env = dict(os.environ, OMP_NUM_THREADS="1")
         proc = subprocess.run(
